@@ -1,0 +1,100 @@
+#include "sunmodel/time_scales.h"
+
+#include <erfa.h>
+
+#include <cmath>
+
+namespace daylit::sunmodel {
+namespace {
+
+constexpr double kSecondsPerDay = 86400.0;
+constexpr double kTtMinusTai = 32.184;
+
+// Last year of ERFA's built-in leap-second table that is history rather than extrapolation is
+// the library's; beyond it eraDat keeps the last TAI − UTC (status +1, "dubious year").
+constexpr int kFirstUtcYear = 1960;
+
+double Horner(double t, std::initializer_list<double> coefficients_high_first) {
+  double value = 0.0;
+  for (const double c : coefficients_high_first) value = value * t + c;
+  return value;
+}
+
+}  // namespace
+
+std::string_view DeltaTSourceName(DeltaTSource source) {
+  switch (source) {
+    case DeltaTSource::kGiven: return "given";
+    case DeltaTSource::kLeapSeconds: return "leap-second table";
+    case DeltaTSource::kHistoricalModel: return "Espenak-Meeus model";
+    case DeltaTSource::kLongTermModel: return "long-term parabola";
+  }
+  return "?";
+}
+
+double ModelDeltaT(double y) {
+  // Espenak & Meeus (2006), "Polynomial expressions for Delta T", valid ranges as published.
+  if (y >= 1800.0 && y < 1860.0) {
+    return Horner(y - 1800.0, {0.000000000875, -0.0000001699, 0.0000121272, -0.00037436,
+                               0.0041116, 0.0068612, -0.332447, 13.72});
+  }
+  if (y >= 1860.0 && y < 1900.0) {
+    return Horner(y - 1860.0, {1.0 / 233174.0, -0.0004473624, 0.01680668, -0.251754, 0.5737, 7.62});
+  }
+  if (y >= 1900.0 && y < 1920.0) {
+    return Horner(y - 1900.0, {-0.000197, 0.0061966, -0.0598939, 1.494119, -2.79});
+  }
+  if (y >= 1920.0 && y < 1941.0) {
+    return Horner(y - 1920.0, {0.0020936, -0.076100, 0.84493, 21.20});
+  }
+  if (y >= 1941.0 && y < 1961.0) {
+    return Horner(y - 1950.0, {1.0 / 2547.0, -1.0 / 233.0, 0.407, 29.07});
+  }
+  if (y >= 1961.0 && y < 1986.0) {
+    return Horner(y - 1975.0, {-1.0 / 718.0, -1.0 / 260.0, 1.067, 45.45});
+  }
+  if (y >= 1986.0 && y < 2005.0) {
+    return Horner(y - 2000.0, {0.00002373599, 0.000651814, 0.0017275, -0.060374, 0.3345, 63.86});
+  }
+  const double u = (y - 1820.0) / 100.0;
+  return -20.0 + 32.0 * u * u;
+}
+
+TimeScales ResolveTimeScales(const UtcTime& utc, const EarthOrientation& orientation) {
+  TimeScales ts;
+  const int whole_second = static_cast<int>(std::floor(utc.second));
+  const double fraction = utc.second - whole_second;
+  double u1 = 0.0, u2 = 0.0;
+  // "UTC" makes ERFA give the leap-second day its 86401 s; before 1960 the status is +1 and the
+  // date is taken as plain UT, which is what the input means there.
+  eraDtf2d("UTC", utc.year, utc.month, utc.day, utc.hour, utc.minute, whole_second, &u1, &u2);
+  u2 += fraction / kSecondsPerDay;
+  const double dut1 = orientation.dut1_s.value_or(0.0);
+  ts.ut1_jd1 = u1;
+  ts.ut1_jd2 = u2 + dut1 / kSecondsPerDay;
+
+  if (orientation.delta_t_s) {
+    ts.source = DeltaTSource::kGiven;
+    ts.delta_t_s = *orientation.delta_t_s;
+  } else if (utc.year >= kFirstUtcYear) {
+    // TT − UTC is exact from the leap-second table; only UT1 − UTC is unknown, and leap
+    // seconds keep it within 0.9 s.
+    double tai1 = 0.0, tai2 = 0.0;
+    eraUtctai(u1, u2, &tai1, &tai2);
+    const double tt_minus_utc_s = ((tai1 - u1) + (tai2 - u2)) * kSecondsPerDay + kTtMinusTai;
+    ts.source = DeltaTSource::kLeapSeconds;
+    ts.delta_t_s = tt_minus_utc_s - dut1;
+    ts.ut1_uncertainty_s = orientation.dut1_s ? 0.0 : 0.9;
+  } else {
+    const double decimal_year = utc.year + (utc.month - 0.5) / 12.0;
+    ts.delta_t_s = ModelDeltaT(decimal_year);
+    const bool historical = decimal_year >= 1800.0;
+    ts.source = historical ? DeltaTSource::kHistoricalModel : DeltaTSource::kLongTermModel;
+    ts.ut1_uncertainty_s = historical ? 1.0 : 60.0;
+  }
+  ts.tt_jd1 = ts.ut1_jd1;
+  ts.tt_jd2 = ts.ut1_jd2 + ts.delta_t_s / kSecondsPerDay;
+  return ts;
+}
+
+}  // namespace daylit::sunmodel
