@@ -71,8 +71,10 @@ int DaysInMonth(int year, int month) {
 
 int64_t UtcTime::UnixDay() const { return DaysFromCivil(year, month, day); }
 
-double UtcTime::PosixSeconds() const {
-  return static_cast<double>(UnixDay()) * 86400.0 + hour * 3600.0 + minute * 60.0 + second;
+double UtcTime::SecondsSince(const UtcTime& earlier) const {
+  const int64_t days = UnixDay() - earlier.UnixDay();
+  const int minutes = (hour - earlier.hour) * 60 + (minute - earlier.minute);
+  return static_cast<double>(days) * 86400.0 + minutes * 60.0 + (second - earlier.second);
 }
 
 bool TryParseUtcTime(std::string_view text, UtcTime* utc, std::string* why) {

@@ -18,9 +18,10 @@ struct UtcTime {
 
   // Days since 1970-01-01 of the date (proleptic Gregorian).
   int64_t UnixDay() const;
-  // Seconds since 1970-01-01T00:00:00Z ignoring leap seconds (POSIX time), for durations and
-  // ordering within a recording; the ephemeris uses the calendar fields, never this.
-  double PosixSeconds() const;
+  // Seconds from `earlier` to this instant, ignoring leap seconds (as POSIX time does), exact to
+  // the double precision of the seconds field; for durations and ordering within a recording.
+  // The ephemeris uses the calendar fields, never this.
+  double SecondsSince(const UtcTime& earlier) const;
 };
 
 // Parses "YYYY-MM-DDTHH:MM[:SS[.fff]]" followed by "Z" or a "+HH:MM"/"-HH:MM"/"+HHMM" offset

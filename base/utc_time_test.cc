@@ -68,7 +68,12 @@ TEST(UtcTimeTest, CivilDaysRoundTripOverFiveCenturies) {
 TEST(UtcTimeTest, FormatRoundsWithoutPrintingSixtySeconds) {
   const UtcTime t = ParseUtcTime("2026-06-21T05:59:59.9996Z", "test");
   EXPECT_EQ(FormatUtcTime(t, 3), "2026-06-21T06:00:00.000Z");
-  EXPECT_NEAR(ParseUtcTime("1969-12-31T23:00:00Z", "t").PosixSeconds(), -3600.0, 1e-9);
+  EXPECT_DOUBLE_EQ(ParseUtcTime("1969-12-31T23:00:00Z", "t")
+                       .SecondsSince(ParseUtcTime("1970-01-01T00:00:00Z", "t")),
+                   -3600.0);
+  EXPECT_DOUBLE_EQ(ParseUtcTime("2026-06-21T16:00:09.9Z", "t")
+                       .SecondsSince(ParseUtcTime("2026-06-21T05:00:00Z", "t")),
+                   11 * 3600 + 9.9);
 }
 
 }  // namespace

@@ -1,0 +1,32 @@
+// frames.csv of a recording: `frame,time_utc[,exposure]`, one row per frame, in order.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include "base/utc_time.h"
+
+namespace daylit::capture {
+
+struct FrameTime {
+  int index = 0;
+  UtcTime utc;
+  std::optional<double> exposure;  // per-frame multiplier k (linear pixel = k · radiance)
+};
+
+struct FrameTimes {
+  std::filesystem::path file;
+  std::vector<FrameTime> frames;
+
+  // Seconds from the first to the last frame (0 for fewer than 2 frames).
+  double SpanSeconds() const;
+  // Exposure of frame i: its own, else `fallback` (camera.exposure).
+  double ExposureOf(size_t i, double fallback) const;
+};
+
+// Reads and validates frames.csv: frame indices 0, 1, 2, ... in order, times with a zone and
+// never going backwards, exposures finite and > 0. Throws InputError naming file, line and column.
+FrameTimes LoadFrameTimes(const std::filesystem::path& csv);
+
+}  // namespace daylit::capture

@@ -1,0 +1,29 @@
+#include "capture/response.h"
+
+#include <gtest/gtest.h>
+
+namespace daylit::capture {
+namespace {
+
+TEST(ResponseTest, SrgbMatchesIec61966Values) {
+  const CameraResponse srgb;
+  EXPECT_NEAR(srgb.ToLinear(0.5), 0.214041, 1e-6);
+  EXPECT_NEAR(srgb.ToLinear(0.04045), 0.04045 / 12.92, 1e-12);  // the linear segment's end
+  EXPECT_NEAR(srgb.LinearLut8()[128], 0.2158605, 1e-6);
+  EXPECT_FLOAT_EQ(srgb.LinearLut8()[255], 1.0f);
+}
+
+TEST(ResponseTest, EveryCurveRoundTrips) {
+  for (const CameraResponse r : {CameraResponse{ResponseCurve::kLinear, 1.0},
+                                 CameraResponse{ResponseCurve::kSrgb, 1.0},
+                                 CameraResponse{ResponseCurve::kGamma, 2.6}}) {
+    for (int i = 0; i <= 1000; ++i) {
+      const double x = i / 1000.0;
+      ASSERT_NEAR(r.ToEncoded(r.ToLinear(x)), x, 1e-9) << r.Describe() << " at " << x;
+    }
+  }
+  EXPECT_NEAR((CameraResponse{ResponseCurve::kGamma, 2.0}.ToLinear(0.5)), 0.25, 1e-12);
+}
+
+}  // namespace
+}  // namespace daylit::capture

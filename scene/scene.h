@@ -1,0 +1,107 @@
+// A recording's scene.json (format daylit-recording/1, docs/recording-format.md), loaded and
+// validated: every path resolved against the recording folder, every field checked.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "base/utc_time.h"
+#include "capture/frame_times.h"
+#include "capture/response.h"
+#include "scene/camera.h"
+#include "scene/model.h"
+#include "sunmodel/geo_frame.h"
+#include "sunmodel/solar_position.h"
+
+namespace daylit::scene {
+
+inline constexpr const char* kRecordingFormat = "daylit-recording/1";
+
+struct EnvMapSpec {
+  std::filesystem::path file;   // OpenEXR or Radiance .hdr, lat-long
+  glm::dvec3 position{0.0};     // capture point, scene coordinates (m)
+  UtcTime time_utc;             // capture time
+  std::optional<glm::dvec3> sun_irradiance_rgb;  // sun DNI at capture, map units
+};
+
+enum class FrameSourceKind { kVideo, kImages, kDevice };
+
+struct FramesSpec {
+  FrameSourceKind kind = FrameSourceKind::kVideo;
+  std::filesystem::path video;       // kVideo
+  std::string image_pattern;         // kImages: absolute path with one %d / %0Nd
+  std::filesystem::path timestamps;  // kVideo, kImages
+  std::string device;                // kDevice, e.g. /dev/video0
+  double fps = 30.0;                 // kDevice
+
+  // The image file of frame `index` (kImages only).
+  std::filesystem::path ImagePath(int index) const;
+};
+
+enum class MeshKind { kSphere, kBox, kFile };
+
+struct VirtualObject {
+  MeshKind kind = MeshKind::kSphere;
+  std::filesystem::path file;       // kFile: glTF 2.0 (.gltf/.glb) or OBJ
+  double radius = 0.0;              // kSphere, m
+  glm::dvec3 size{0.0};             // kBox: full edge lengths, m
+  glm::dvec3 position{0.0};         // centre, scene coordinates (m)
+  glm::dvec3 rotation_deg{0.0};     // XYZ Euler, R = Rz·Ry·Rx
+  glm::dvec3 scale{1.0};
+  std::optional<glm::dvec3> albedo;  // override, each in [0, 1]
+
+  // Radius of a sphere around `position` that holds the object (mesh files: 1 m × scale until
+  // the mesh is loaded by the renderer).
+  double BoundingRadius() const;
+};
+
+struct VolumeSpec {
+  glm::dvec3 min{0.0}, max{0.0};  // scene coordinates (m)
+  glm::ivec3 resolution{2};       // probes per axis, each ≥ 2
+  bool defaulted = false;         // true when derived from the objects
+};
+
+struct GroundTruthSpec {
+  std::optional<std::filesystem::path> lighting;    // groundtruth.csv
+  std::optional<std::filesystem::path> composites;  // groundtruth/ folder
+};
+
+struct Scene {
+  std::filesystem::path file;    // the scene.json
+  std::filesystem::path folder;  // where relative paths start
+  std::string name;
+
+  sunmodel::GeoSite location;
+  double north_azimuth_deg = 0.0;
+
+  SceneModel model;
+  std::vector<std::string> diffuse_globs;
+  std::vector<int> diffuse_surfaces;  // surface indices matched by diffuse_globs
+  std::optional<std::filesystem::path> diffuse_mask;
+
+  CameraIntrinsics intrinsics;
+  RigidPose cam_from_world;
+  std::optional<PoseFit> pose_fit;  // set when the pose was solved from correspondences
+  capture::CameraResponse response;
+  double exposure = 1.0;
+
+  std::optional<EnvMapSpec> envmap;
+  FramesSpec frames;
+  std::optional<capture::FrameTimes> frame_times;  // recordings (not live devices)
+  std::vector<VirtualObject> objects;
+  std::optional<VolumeSpec> volume;  // absent only with neither `volume` nor objects
+  GroundTruthSpec groundtruth;
+
+  CameraModel Camera() const { return CameraModel(intrinsics, cam_from_world); }
+  sunmodel::SceneGeoFrame GeoFrame() const { return {location, north_azimuth_deg}; }
+};
+
+// Loads `path` (a scene.json, or a recording folder holding one), the OBJ model it names and
+// its frames.csv, and checks every field. Throws InputError "<file>: <field>: <problem>".
+Scene LoadScene(const std::filesystem::path& path);
+
+}  // namespace daylit::scene

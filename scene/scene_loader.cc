@@ -1,0 +1,367 @@
+#include <algorithm>
+#include <cmath>
+#include <regex>
+
+#include "base/error.h"
+#include "base/log.h"
+#include "scene/json_fields.h"
+#include "scene/scene.h"
+
+namespace daylit::scene {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Tolerance on |RᵀR − I| for a rotation typed with ~9 significant digits.
+constexpr double kRotationTolerance = 1e-5;
+
+fs::path Resolve(const Scene& scene, const std::string& relative) {
+  const fs::path p(relative);
+  return p.is_absolute() ? p : scene.folder / p;
+}
+
+// The path a field names, which must exist as a regular file.
+fs::path RequireFile(const Scene& scene, const JsonField& field) {
+  const std::string relative = field.String();
+  const fs::path path = Resolve(scene, relative);
+  if (!fs::is_regular_file(path)) field.Fail(fmt::format("file '{}' not found", path.string()));
+  return path;
+}
+
+void LoadLocation(const JsonField& root, Scene* scene) {
+  const JsonField location = root.Get("location");
+  location.WarnUnknownKeys({"latitude_deg", "longitude_deg", "elevation_m"});
+  scene->location.latitude_deg = location.Get("latitude_deg").Number();
+  scene->location.longitude_deg = location.Get("longitude_deg").Number();
+  if (auto e = location.Find("elevation_m")) scene->location.elevation_m = e->Number();
+  if (const std::string why = scene->location.Check(); !why.empty()) location.Fail(why);
+  if (auto n = root.Find("north_azimuth_deg")) scene->north_azimuth_deg = n->Number();
+}
+
+void LoadModelAndSurfaces(const JsonField& root, Scene* scene) {
+  const JsonField model = root.Get("model");
+  model.WarnUnknownKeys({"file"});
+  const JsonField file = model.Get("file");
+  scene->model = LoadObjModel(RequireFile(*scene, file));
+
+  if (auto mask = root.Find("diffuse_mask")) scene->diffuse_mask = RequireFile(*scene, *mask);
+  const std::optional<JsonField> globs = root.Find("diffuse_surfaces");
+  if (!globs && !scene->diffuse_mask) {
+    root.Get("diffuse_surfaces");  // throws "missing": one of the two is needed
+  }
+  if (!globs) return;
+  for (const JsonField& g : globs->Elements()) {
+    const std::string glob = g.String();
+    const std::vector<int> matched = scene->model.MatchSurfaces(glob);
+    if (matched.empty()) {
+      std::string names;
+      for (const std::string& n : scene->model.surface_names) names += (names.empty() ? "" : ", ") + n;
+      g.Fail(fmt::format("'{}' matches no surface of {} (surfaces: {})", glob,
+                         scene->model.file.filename().string(), names));
+    }
+    scene->diffuse_globs.push_back(glob);
+    for (const int s : matched) {
+      if (std::find(scene->diffuse_surfaces.begin(), scene->diffuse_surfaces.end(), s) ==
+          scene->diffuse_surfaces.end()) {
+        scene->diffuse_surfaces.push_back(s);
+      }
+    }
+  }
+}
+
+capture::CameraResponse LoadResponse(const JsonField& field) {
+  capture::CameraResponse response;
+  if (field.IsString()) {
+    const std::string name = field.String();
+    if (name == "srgb") return response;
+    if (name == "linear") {
+      response.curve = capture::ResponseCurve::kLinear;
+      return response;
+    }
+    field.Fail(fmt::format("'{}' is not a response: use \"linear\", \"srgb\" or {{\"gamma\": g}}", name));
+  }
+  if (!field.IsObject()) field.Fail("expected \"linear\", \"srgb\" or {\"gamma\": g}");
+  const JsonField gamma = field.Get("gamma");
+  response.curve = capture::ResponseCurve::kGamma;
+  response.gamma = gamma.Number();
+  if (response.gamma < 0.1 || response.gamma > 10.0) {
+    gamma.Fail(fmt::format("{} is outside [0.1, 10]", response.gamma));
+  }
+  return response;
+}
+
+void LoadPose(const JsonField& camera, Scene* scene) {
+  if (auto correspondences = camera.Find("correspondences")) {
+    std::vector<glm::dvec3> world;
+    std::vector<glm::dvec2> pixels;
+    for (const JsonField& c : correspondences->Elements()) {
+      world.push_back(c.Get("world").Vec3());
+      const std::vector<double> px = c.Get("pixel").Numbers();
+      if (px.size() != 2) c.Get("pixel").Fail(fmt::format("expected 2 numbers, got {}", px.size()));
+      pixels.emplace_back(px[0], px[1]);
+    }
+    PoseFit fit;
+    std::string why;
+    if (!SolvePoseFromCorrespondences(scene->intrinsics, world, pixels, &fit, &why)) {
+      correspondences->Fail(why);
+    }
+    if (camera.Has("world_to_camera")) {
+      Log().info("{}: camera: pose solved from correspondences; world_to_camera ignored",
+                 scene->file.string());
+    }
+    scene->cam_from_world = fit.cam_from_world;
+    scene->pose_fit = fit;
+    return;
+  }
+  const JsonField pose = camera.Get("world_to_camera");
+  pose.WarnUnknownKeys({"rotation", "translation"});
+  const JsonField rotation = pose.Get("rotation");
+  const glm::dmat3 r = rotation.Matrix3();
+  if (!IsRotation(r, kRotationTolerance)) {
+    rotation.Fail(fmt::format("not a rotation (|RᵀR − I| = {:.3g}, det = {:.6g})",
+                              OrthonormalityError(r), glm::determinant(r)));
+  }
+  scene->cam_from_world.rotation = NearestRotation(r);
+  scene->cam_from_world.translation = pose.Get("translation").Vec3();
+}
+
+void LoadCamera(const JsonField& root, Scene* scene) {
+  const JsonField camera = root.Get("camera");
+  camera.WarnUnknownKeys({"width", "height", "fx", "fy", "cx", "cy", "distortion",
+                          "world_to_camera", "correspondences", "response", "exposure"});
+  CameraIntrinsics& k = scene->intrinsics;
+  for (const auto& [key, value] : {std::pair{"width", &k.width}, std::pair{"height", &k.height}}) {
+    const JsonField f = camera.Get(key);
+    *value = f.Integer();
+    if (*value <= 0 || *value > 16384) f.Fail(fmt::format("{} is outside [1, 16384]", *value));
+  }
+  for (const auto& [key, value] : {std::pair{"fx", &k.fx}, std::pair{"fy", &k.fy}}) {
+    const JsonField f = camera.Get(key);
+    *value = f.Number();
+    if (*value <= 0.0) f.Fail(fmt::format("must be > 0 (got {})", *value));
+  }
+  k.cx = camera.Get("cx").Number();
+  k.cy = camera.Get("cy").Number();
+  if (auto d = camera.Find("distortion")) {
+    k.distortion = d->Numbers();
+    const size_t n = k.distortion.size();
+    if (n != 0 && n != 4 && n != 5 && n != 8 && n != 12 && n != 14) {
+      d->Fail(fmt::format("expected 4, 5, 8, 12 or 14 coefficients (k1, k2, p1, p2, k3, ...), got {}", n));
+    }
+  }
+  if (auto response = camera.Find("response")) scene->response = LoadResponse(*response);
+  if (auto exposure = camera.Find("exposure")) {
+    scene->exposure = exposure->Number();
+    if (scene->exposure <= 0.0) exposure->Fail(fmt::format("must be > 0 (got {})", scene->exposure));
+  }
+  LoadPose(camera, scene);
+}
+
+void LoadEnvMap(const JsonField& root, Scene* scene) {
+  const std::optional<JsonField> env = root.Find("envmap");
+  if (!env) return;
+  env->WarnUnknownKeys({"file", "position", "time_utc", "sun_irradiance_rgb"});
+  EnvMapSpec spec;
+  const JsonField file = env->Get("file");
+  spec.file = RequireFile(*scene, file);
+  const std::string ext = spec.file.extension().string();
+  if (ext != ".exr" && ext != ".hdr") file.Fail("expected an OpenEXR (.exr) or Radiance (.hdr) file");
+  spec.position = env->Get("position").Vec3();
+  const JsonField time = env->Get("time_utc");
+  spec.time_utc = ParseUtcTime(time.String(), fmt::format("{}: {}", scene->file.string(), time.path()));
+  if (auto sun = env->Find("sun_irradiance_rgb")) {
+    spec.sun_irradiance_rgb = sun->Vec3();
+    for (int c = 0; c < 3; ++c) {
+      if ((*spec.sun_irradiance_rgb)[c] < 0.0) sun->Fail("must be ≥ 0");
+    }
+  }
+  scene->envmap = spec;
+}
+
+// Checks a printf pattern with exactly one integer conversion (%d or %0Nd) and no other %.
+bool IsFramePattern(const std::string& pattern) {
+  static const std::regex kPattern("^[^%]*%0?[0-9]?d[^%]*$");
+  return std::regex_match(pattern, kPattern);
+}
+
+void LoadFrames(const JsonField& root, Scene* scene) {
+  const JsonField frames = root.Get("frames");
+  frames.WarnUnknownKeys({"video", "images", "timestamps", "device", "fps"});
+  FramesSpec& spec = scene->frames;
+  const int kinds = frames.Has("video") + frames.Has("images") + frames.Has("device");
+  if (kinds != 1) frames.Fail("give exactly one of \"video\", \"images\" or \"device\"");
+  if (auto device = frames.Find("device")) {
+    spec.kind = FrameSourceKind::kDevice;
+    spec.device = device->String();
+    if (auto fps = frames.Find("fps")) {
+      spec.fps = fps->Number();
+      if (spec.fps <= 0.0 || spec.fps > 1000.0) fps->Fail(fmt::format("{} is outside (0, 1000]", spec.fps));
+    }
+    return;
+  }
+  if (auto video = frames.Find("video")) {
+    spec.kind = FrameSourceKind::kVideo;
+    spec.video = RequireFile(*scene, *video);
+  } else {
+    const JsonField images = frames.Get("images");
+    spec.kind = FrameSourceKind::kImages;
+    const std::string pattern = images.String();
+    if (!IsFramePattern(pattern)) {
+      images.Fail(fmt::format("'{}' must contain exactly one %d or %0Nd (e.g. frames/%06d.png)", pattern));
+    }
+    spec.image_pattern = Resolve(*scene, pattern).string();
+    if (!fs::is_regular_file(spec.ImagePath(0))) {
+      images.Fail(fmt::format("frame 0 ('{}') not found", spec.ImagePath(0).string()));
+    }
+  }
+  spec.timestamps = RequireFile(*scene, frames.Get("timestamps"));
+  scene->frame_times = capture::LoadFrameTimes(spec.timestamps);
+}
+
+void LoadObjects(const JsonField& root, Scene* scene) {
+  const std::optional<JsonField> objects = root.Find("objects");
+  if (!objects) return;
+  for (const JsonField& o : objects->Elements()) {
+    o.WarnUnknownKeys({"mesh", "radius", "size", "position", "rotation_deg", "scale", "albedo", "name"});
+    VirtualObject object;
+    const JsonField mesh = o.Get("mesh");
+    const std::string kind = mesh.String();
+    if (kind == "builtin:sphere") {
+      object.kind = MeshKind::kSphere;
+      const JsonField radius = o.Get("radius");
+      object.radius = radius.Number();
+      if (object.radius <= 0.0) radius.Fail(fmt::format("must be > 0 (got {})", object.radius));
+    } else if (kind == "builtin:box") {
+      object.kind = MeshKind::kBox;
+      const JsonField size = o.Get("size");
+      object.size = size.Vec3();
+      if (glm::any(glm::lessThanEqual(object.size, glm::dvec3(0.0)))) size.Fail("every edge must be > 0");
+    } else if (kind.rfind("builtin:", 0) == 0) {
+      mesh.Fail(fmt::format("'{}' is not a builtin: use builtin:sphere or builtin:box", kind));
+    } else {
+      object.kind = MeshKind::kFile;
+      object.file = RequireFile(*scene, mesh);
+      const std::string ext = object.file.extension().string();
+      if (ext != ".gltf" && ext != ".glb" && ext != ".obj") {
+        mesh.Fail("expected a glTF 2.0 (.gltf, .glb) or OBJ (.obj) file");
+      }
+    }
+    if (auto p = o.Find("position")) object.position = p->Vec3();
+    if (auto r = o.Find("rotation_deg")) object.rotation_deg = r->Vec3();
+    if (auto s = o.Find("scale")) {
+      object.scale = s->value().is_number() ? glm::dvec3(s->Number()) : s->Vec3();
+      if (glm::any(glm::lessThanEqual(object.scale, glm::dvec3(0.0)))) s->Fail("must be > 0");
+    }
+    if (auto a = o.Find("albedo")) {
+      object.albedo = a->Vec3();
+      if (glm::any(glm::lessThan(*object.albedo, glm::dvec3(0.0))) ||
+          glm::any(glm::greaterThan(*object.albedo, glm::dvec3(1.0)))) {
+        a->Fail("each channel must be in [0, 1]");
+      }
+    }
+    scene->objects.push_back(object);
+  }
+}
+
+// Probes every 0.5 m over the objects' bounds plus 1 m (shadows and contact light), 2..32 per axis.
+VolumeSpec DefaultVolume(const std::vector<VirtualObject>& objects) {
+  VolumeSpec v;
+  v.min = glm::dvec3(1e300);
+  v.max = glm::dvec3(-1e300);
+  for (const VirtualObject& o : objects) {
+    v.min = glm::min(v.min, o.position - glm::dvec3(o.BoundingRadius() + 1.0));
+    v.max = glm::max(v.max, o.position + glm::dvec3(o.BoundingRadius() + 1.0));
+  }
+  const glm::dvec3 extent = v.max - v.min;
+  for (int a = 0; a < 3; ++a) {
+    v.resolution[a] = std::clamp(static_cast<int>(std::ceil(extent[a] / 0.5)) + 1, 2, 32);
+  }
+  v.defaulted = true;
+  return v;
+}
+
+void LoadVolume(const JsonField& root, Scene* scene) {
+  const std::optional<JsonField> volume = root.Find("volume");
+  if (!volume) {
+    if (!scene->objects.empty()) scene->volume = DefaultVolume(scene->objects);
+    return;
+  }
+  volume->WarnUnknownKeys({"min", "max", "resolution"});
+  VolumeSpec v;
+  v.min = volume->Get("min").Vec3();
+  v.max = volume->Get("max").Vec3();
+  if (glm::any(glm::greaterThanEqual(v.min, v.max))) volume->Get("max").Fail("must exceed min on every axis");
+  const JsonField resolution = volume->Get("resolution");
+  const std::vector<JsonField> r = resolution.Elements();
+  if (r.size() != 3) resolution.Fail(fmt::format("expected 3 integers, got {}", r.size()));
+  for (int a = 0; a < 3; ++a) {
+    v.resolution[a] = r[static_cast<size_t>(a)].Integer();
+    if (v.resolution[a] < 1 || v.resolution[a] > 256) {
+      r[static_cast<size_t>(a)].Fail(fmt::format("{} is outside [1, 256]", v.resolution[a]));
+    }
+  }
+  scene->volume = v;
+}
+
+void LoadGroundTruth(const JsonField& root, Scene* scene) {
+  const std::optional<JsonField> gt = root.Find("groundtruth");
+  if (!gt) return;
+  gt->WarnUnknownKeys({"lighting", "composites"});
+  if (auto lighting = gt->Find("lighting")) scene->groundtruth.lighting = RequireFile(*scene, *lighting);
+  if (auto composites = gt->Find("composites")) {
+    const fs::path folder = Resolve(*scene, composites->String());
+    if (!fs::is_directory(folder)) composites->Fail(fmt::format("folder '{}' not found", folder.string()));
+    scene->groundtruth.composites = folder;
+  }
+}
+
+}  // namespace
+
+fs::path FramesSpec::ImagePath(int index) const {
+  const size_t percent = image_pattern.find('%');
+  const size_t d = image_pattern.find('d', percent);
+  const std::string spec = image_pattern.substr(percent + 1, d - percent - 1);  // "", "06", "6"
+  const int width = spec.empty() ? 0 : std::stoi(spec);
+  return image_pattern.substr(0, percent) + fmt::format("{:0{}d}", index, width) +
+         image_pattern.substr(d + 1);
+}
+
+double VirtualObject::BoundingRadius() const {
+  const double s = std::max({scale.x, scale.y, scale.z});
+  switch (kind) {
+    case MeshKind::kSphere: return radius * s;
+    case MeshKind::kBox: return 0.5 * glm::length(size) * s;
+    case MeshKind::kFile: return s;
+  }
+  return s;
+}
+
+Scene LoadScene(const fs::path& path) {
+  Scene scene;
+  scene.file = fs::is_directory(path) ? path / "scene.json" : path;
+  if (!fs::is_regular_file(scene.file)) ThrowInputError("{}: no such file", scene.file.string());
+  scene.folder = scene.file.parent_path();
+  const nlohmann::json json = ReadJsonFile(scene.file);
+  const JsonField root(json, scene.file.string(), "");
+  if (!json.is_object()) root.Fail("expected a JSON object");
+  root.WarnUnknownKeys({"format", "name", "location", "north_azimuth_deg", "model", "diffuse_surfaces",
+                        "diffuse_mask", "camera", "envmap", "frames", "objects", "volume",
+                        "groundtruth"});
+  const JsonField format = root.Get("format");
+  if (format.String() != kRecordingFormat) {
+    format.Fail(fmt::format("'{}' is not supported (expected '{}')", format.String(), kRecordingFormat));
+  }
+  scene.name = root.Has("name") ? root.Get("name").String()
+                                : fs::absolute(scene.folder).lexically_normal().filename().string();
+  LoadLocation(root, &scene);
+  LoadModelAndSurfaces(root, &scene);
+  LoadCamera(root, &scene);
+  LoadEnvMap(root, &scene);
+  LoadFrames(root, &scene);
+  LoadObjects(root, &scene);
+  LoadVolume(root, &scene);
+  LoadGroundTruth(root, &scene);
+  return scene;
+}
+
+}  // namespace daylit::scene

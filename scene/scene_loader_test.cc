@@ -1,0 +1,212 @@
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include "base/error.h"
+#include "scene/scene.h"
+#include "scene/scene_test_util.h"
+
+namespace daylit::scene {
+namespace {
+
+using testing::SceneSandbox;
+
+TEST(SceneLoaderTest, LoadsTheBundledRecordingCompletely) {
+  const Scene scene = LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a");
+  EXPECT_EQ(scene.name, "courtyard-a");
+  EXPECT_DOUBLE_EQ(scene.location.latitude_deg, 57.0488);
+  EXPECT_DOUBLE_EQ(scene.location.elevation_m, 10.0);
+  EXPECT_DOUBLE_EQ(scene.north_azimuth_deg, -20.0);
+  EXPECT_EQ(scene.model.surface_names.size(), 10u);
+  // ground + wall_east + 5 building_*; far_ground, pillar and bench are not diffuse surfaces.
+  EXPECT_EQ(scene.diffuse_surfaces.size(), 7u);
+  EXPECT_EQ(scene.intrinsics.width, 960);
+  EXPECT_DOUBLE_EQ(scene.intrinsics.cx, 479.5);
+  EXPECT_EQ(scene.response.curve, capture::ResponseCurve::kSrgb);
+  EXPECT_NEAR(scene.exposure, 0.198425, 1e-6);
+  EXPECT_NEAR(glm::determinant(scene.cam_from_world.rotation), 1.0, 1e-12);
+  ASSERT_TRUE(scene.envmap.has_value());
+  EXPECT_EQ(FormatUtcTime(scene.envmap->time_utc, 0), "2026-06-21T05:00:00Z");
+  EXPECT_NEAR(scene.envmap->sun_irradiance_rgb->x, 86.25683, 1e-9);
+  EXPECT_EQ(scene.frames.kind, FrameSourceKind::kVideo);
+  ASSERT_TRUE(scene.frame_times.has_value());
+  EXPECT_EQ(scene.frame_times->frames.size(), 600u);
+  ASSERT_EQ(scene.objects.size(), 2u);
+  EXPECT_EQ(scene.objects[1].kind, MeshKind::kBox);
+  EXPECT_DOUBLE_EQ(scene.objects[1].size.z, 1.0);
+  ASSERT_TRUE(scene.volume.has_value());
+  EXPECT_FALSE(scene.volume->defaulted);
+  EXPECT_EQ(scene.volume->resolution, glm::ivec3(10, 8, 4));
+  EXPECT_TRUE(scene.groundtruth.lighting.has_value());
+  // The camera stands about 6.8 m from the origin, above the ground, looking down at it.
+  const glm::dvec3 center = scene.Camera().CenterInWorld();
+  EXPECT_GT(center.z, 1.0);
+  EXPECT_GT(scene.Camera().UnprojectToWorldRay({479.5, 269.5}).z, -1.0);
+}
+
+TEST(SceneLoaderTest, DefaultsFillOmittedFields) {
+  SceneSandbox sandbox("defaults");
+  nlohmann::json& j = sandbox.json();
+  j.erase("name");
+  j.erase("north_azimuth_deg");
+  j["location"].erase("elevation_m");
+  j["camera"].erase("distortion");
+  j["camera"].erase("response");
+  j["camera"].erase("exposure");
+  j.erase("volume");
+  j.erase("envmap");
+  j.erase("groundtruth");
+  const Scene scene = LoadScene(sandbox.Write());
+  EXPECT_EQ(scene.name, sandbox.dir().filename().string());
+  EXPECT_EQ(scene.north_azimuth_deg, 0.0);
+  EXPECT_EQ(scene.location.elevation_m, 0.0);
+  EXPECT_TRUE(scene.intrinsics.distortion.empty());
+  EXPECT_EQ(scene.response.curve, capture::ResponseCurve::kSrgb);
+  EXPECT_EQ(scene.exposure, 1.0);
+  EXPECT_FALSE(scene.envmap.has_value());
+  // Volume around the two objects: sphere r 0.5 at (-0.8,-2.2,0.5) and a box at (1.6,-0.6,0.5).
+  ASSERT_TRUE(scene.volume.has_value());
+  EXPECT_TRUE(scene.volume->defaulted);
+  EXPECT_NEAR(scene.volume->min.x, -0.8 - 0.5 - 1.0, 1e-9);
+  EXPECT_GE(scene.volume->resolution.x, 2);
+}
+
+TEST(SceneLoaderTest, PoseFromCorrespondencesMatchesTheGivenPose) {
+  SceneSandbox sandbox("pnp");
+  const Scene reference = LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a");
+  const CameraModel camera = reference.Camera();
+  nlohmann::json correspondences = nlohmann::json::array();
+  // Corners of the courtyard's ground, walls and bench that the camera sees.
+  for (const glm::dvec3 p : {glm::dvec3(-2, -3, 0), glm::dvec3(2, -3, 0), glm::dvec3(2, 0, 0),
+                             glm::dvec3(-2, 0, 0), glm::dvec3(0, -2, 1), glm::dvec3(1, -4, 2),
+                             glm::dvec3(-1.5, -1, 0.5), glm::dvec3(1.5, -2, 1.5)}) {
+    const glm::dvec2 px = camera.Project(p);
+    correspondences.push_back({{"world", {p.x, p.y, p.z}}, {"pixel", {px.x, px.y}}});
+  }
+  sandbox.json()["camera"]["correspondences"] = correspondences;
+  sandbox.json()["camera"].erase("world_to_camera");
+  const Scene solved = LoadScene(sandbox.Write());
+  ASSERT_TRUE(solved.pose_fit.has_value());
+  EXPECT_LT(solved.pose_fit->rms_reprojection_px, 1e-6);
+  EXPECT_NEAR(glm::length(solved.Camera().CenterInWorld() - camera.CenterInWorld()), 0.0, 1e-6);
+}
+
+struct BadScene {
+  const char* what;
+  std::function<void(nlohmann::json&, const SceneSandbox&)> edit;
+  const char* expected;  // the error message after "<dir>/scene.json: "
+};
+
+class SceneLoaderBadInputTest : public ::testing::TestWithParam<BadScene> {};
+
+TEST_P(SceneLoaderBadInputTest, NamesFileAndField) {
+  SceneSandbox sandbox("bad");
+  GetParam().edit(sandbox.json(), sandbox);
+  const std::filesystem::path file = sandbox.Write();
+  try {
+    LoadScene(file);
+    FAIL() << GetParam().what << ": no error";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(GetParam().expected), std::string::npos)
+        << GetParam().what << ": got: " << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "one line: " << message;
+  }
+}
+
+const BadScene kBadScenes[] = {
+    {"missing field", [](auto& j, auto&) { j.erase("location"); }, "scene.json: location: missing"},
+    {"wrong format", [](auto& j, auto&) { j["format"] = "daylit-recording/9"; },
+     "format: 'daylit-recording/9' is not supported"},
+    {"latitude 123", [](auto& j, auto&) { j["location"]["latitude_deg"] = 123; },
+     "location: latitude_deg: 123 is outside [-90, 90]"},
+    {"wrong type", [](auto& j, auto&) { j["camera"]["fx"] = "760"; },
+     "camera.fx: expected a number, got string"},
+    {"null number", [](auto& j, auto&) { j["north_azimuth_deg"] = nullptr; },
+     "north_azimuth_deg: expected a number, got null"},
+    {"negative focal length", [](auto& j, auto&) { j["camera"]["fy"] = -3; },
+     "camera.fy: must be > 0 (got -3)"},
+    {"unknown surface", [](auto& j, auto&) { j["diffuse_surfaces"][1] = "wal_*"; },
+     "diffuse_surfaces[1]: 'wal_*' matches no surface of model.obj"},
+    {"unreadable model", [](auto& j, auto&) { j["model"]["file"] = "missing.obj"; },
+     "model.file: file '"},
+    {"not a rotation", [](auto& j, auto&) { j["camera"]["world_to_camera"]["rotation"][0][0] = 0.5; },
+     "camera.world_to_camera.rotation: not a rotation"},
+    {"reflection", [](auto& j, auto&) {
+       j["camera"]["world_to_camera"]["rotation"] = {{1, 0, 0}, {0, 1, 0}, {0, 0, -1}};
+     }, "camera.world_to_camera.rotation: not a rotation (|RᵀR − I| = 0, det = -1)"},
+    {"rotation shape", [](auto& j, auto&) { j["camera"]["world_to_camera"]["rotation"][2] = {1, 2}; },
+     "camera.world_to_camera.rotation[2]: expected 3 numbers, got 2"},
+    {"time without zone", [](auto& j, auto&) { j["envmap"]["time_utc"] = "2026-06-21T05:00:00"; },
+     "envmap.time_utc: time has no zone"},
+    {"two frame sources", [](auto& j, auto&) { j["frames"]["device"] = "/dev/video0"; },
+     "frames: give exactly one of \"video\", \"images\" or \"device\""},
+    {"bad image pattern", [](auto& j, auto&) {
+       j["frames"].erase("video");
+       j["frames"]["images"] = "frames/%s.png";
+     }, "frames.images: 'frames/%s.png' must contain exactly one %d"},
+    {"bad response", [](auto& j, auto&) { j["camera"]["response"] = "log"; },
+     "camera.response: 'log' is not a response"},
+    {"bad distortion", [](auto& j, auto&) { j["camera"]["distortion"] = {0.1, 0.2}; },
+     "camera.distortion: expected 4, 5, 8, 12 or 14 coefficients"},
+    {"negative radius", [](auto& j, auto&) { j["objects"][0]["radius"] = -1; },
+     "objects[0].radius: must be > 0 (got -1)"},
+    {"unknown builtin", [](auto& j, auto&) { j["objects"][1]["mesh"] = "builtin:cone"; },
+     "objects[1].mesh: 'builtin:cone' is not a builtin"},
+    {"volume inverted", [](auto& j, auto&) { j["volume"]["max"][2] = -1; },
+     "volume.max: must exceed min on every axis"},
+    {"too few correspondences", [](auto& j, auto&) {
+       j["camera"]["correspondences"] = {{{"world", {0, 0, 0}}, {"pixel", {1, 2}}}};
+     }, "camera.correspondences: at least 4 correspondences are needed, got 1"},
+    {"OBJ with NaN vertex", [](auto& j, const SceneSandbox& s) {
+       s.WriteText("nan.obj", "o ground\nv 0 0 0\nv nan 1 0\nv 1 1 0\nf 1 2 3\n");
+       j["model"]["file"] = "nan.obj";
+     }, "nan.obj:3: vertex coordinate x is not a finite number ('nan')"},
+    {"OBJ face out of range", [](auto& j, const SceneSandbox& s) {
+       s.WriteText("oob.obj", "o ground\nv 0 0 0\nv 1 1 0\nv 1 0 0\nf 1 2 9\n");
+       j["model"]["file"] = "oob.obj";
+     }, "oob.obj: Vertex indices out of bounds"},
+    {"frames.csv without zone", [](auto& j, const SceneSandbox& s) {
+       s.WriteText("frames_bad.csv", "frame,time_utc\n0,2026-06-21T05:00:00\n");
+       j["frames"]["timestamps"] = "frames_bad.csv";
+     }, "frames_bad.csv:2: time_utc: time has no zone"},
+};
+
+INSTANTIATE_TEST_SUITE_P(Table, SceneLoaderBadInputTest, ::testing::ValuesIn(kBadScenes),
+                         [](const ::testing::TestParamInfo<BadScene>& info) {
+                           std::string name = info.param.what;
+                           for (char& c : name) {
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           }
+                           return name;
+                         });
+
+TEST(SceneLoaderTest, MalformedJsonNamesLineAndColumn) {
+  SceneSandbox sandbox("malformed");
+  const std::filesystem::path file = sandbox.WriteText("scene.json", "{\n \"format\": \"daylit-recording/1\",\n \"location\": {,\n}\n");
+  try {
+    LoadScene(file);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.json: invalid JSON"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(LoadScene(sandbox.dir() / "nothing.json"), InputError);
+}
+
+TEST(SceneLoaderTest, NumbersBeyondDoubleRangeAreRejected) {
+  SceneSandbox sandbox("overflow");
+  std::string text = sandbox.json().dump(1);
+  text.replace(text.find("\"north_azimuth_deg\": -20.0"), 26, "\"north_azimuth_deg\": 1e999");
+  const std::filesystem::path file = sandbox.WriteText("scene.json", text);
+  try {
+    LoadScene(file);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.json: invalid JSON"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("1e999"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace daylit::scene
