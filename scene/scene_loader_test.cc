@@ -173,8 +173,8 @@ const BadScene kBadScenes[] = {
 };
 
 INSTANTIATE_TEST_SUITE_P(Table, SceneLoaderBadInputTest, ::testing::ValuesIn(kBadScenes),
-                         [](const ::testing::TestParamInfo<BadScene>& info) {
-                           std::string name = info.param.what;
+                         [](const ::testing::TestParamInfo<BadScene>& param_info) {
+                           std::string name = param_info.param.what;
                            for (char& c : name) {
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            }
