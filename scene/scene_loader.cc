@@ -338,6 +338,7 @@ double VirtualObject::BoundingRadius() const {
 
 Scene LoadScene(const fs::path& path) {
   Scene scene;
+  if (!fs::exists(path)) ThrowInputError("{}: no such file or folder", path.string());
   scene.file = fs::is_directory(path) ? path / "scene.json" : path;
   if (!fs::is_regular_file(scene.file)) ThrowInputError("{}: no such file", scene.file.string());
   scene.folder = scene.file.parent_path();

@@ -1,0 +1,12 @@
+// The subcommands of `daylit`. Each Add*Command registers itself on the app; its callback
+// writes results to stdout or files and throws InputError for bad input (exit code 2).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace daylit::app {
+
+void AddSunposCommand(CLI::App& app);
+void AddInfoCommand(CLI::App& app);
+
+}  // namespace daylit::app

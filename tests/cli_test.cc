@@ -1,0 +1,144 @@
+// The `daylit` binary as a user runs it: exit codes, one-line errors on stderr, results on stdout.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "base/atomic_file.h"
+#include "base/csv.h"
+#include "scene/scene_test_util.h"
+
+namespace daylit {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+CliRun Daylit(const std::string& args) {
+  static int counter = 0;
+  const fs::path err_file = fs::temp_directory_path() /
+                            ("daylit_cli_err_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+  const std::string command = std::string(DAYLIT_BINARY_DIR "/bin/daylit ") + args + " 2>" + err_file.string();
+  CliRun run;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  std::array<char, 4096> buffer;
+  size_t n = 0;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  run.err = ReadTextFile(err_file);
+  fs::remove(err_file);
+  return run;
+}
+
+const std::string kRecording = DAYLIT_SOURCE_DIR "/recordings/courtyard-a";
+
+TEST(CliTest, HelpForEverySubcommand) {
+  for (const char* sub : {"", "sunpos ", "info "}) {
+    const CliRun run = Daylit(std::string(sub) + "--help");
+    EXPECT_EQ(run.exit_code, 0) << sub;
+    EXPECT_NE(run.out.find("Usage"), std::string::npos) << sub << run.out;
+  }
+  const CliRun none = Daylit("");
+  EXPECT_EQ(none.exit_code, 2);
+}
+
+TEST(CliTest, InfoSummarisesTheBundledRecording) {
+  const CliRun run = Daylit("info " + kRecording);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("600 frames"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("6 bursts"), std::string::npos);
+  EXPECT_NE(run.out.find("span 11 h 00 min 09.9 s"), std::string::npos);
+  EXPECT_NE(run.out.find("OpenEXR 1024x512"), std::string::npos);
+  EXPECT_NE(run.out.find("missing      nothing"), std::string::npos);
+  EXPECT_EQ(run.err, "");  // nothing to warn about
+}
+
+TEST(CliTest, SunposSingleAndSceneVector) {
+  const CliRun run = Daylit("sunpos --time 2003-10-17T12:30:30-07:00 --lat 39.742476 --lon -105.1786 "
+                         "--elev 1830.14 --pressure 820 --temp 11 --delta-t 67");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("zenith_deg           50.1279"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("azimuth_deg          194.340"), std::string::npos) << run.out;
+  const CliRun scene = Daylit("sunpos --time 2026-06-21T05:00:05Z --scene " + kRecording);
+  ASSERT_EQ(scene.exit_code, 0) << scene.err;
+  EXPECT_NE(scene.out.find("sun_in_scene         0.957"), std::string::npos) << scene.out;
+}
+
+TEST(CliTest, SunposFramesWritesOneRowPerFrame) {
+  const fs::path out = fs::temp_directory_path() / ("daylit_cli_frames_" + std::to_string(::getpid()) + ".csv");
+  const CliRun run = Daylit("sunpos --scene " + kRecording + " --frames --out " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const CsvTable table = ReadCsvFile(out);
+  fs::remove(out);
+  EXPECT_EQ(table.rows.size(), 600u);
+  EXPECT_EQ(table.header.back(), "sun_z");
+}
+
+TEST(CliTest, SunposCsvBatchMatchesThePublishedSpaExample) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_csv_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  WriteFileAtomically(dir / "in.csv",
+                      "temp_c,utc,lat_deg,lon_deg,elev_m,pressure_hpa,delta_t_s,note\n"
+                      "11,2003-10-17T19:30:30Z,39.742476,-105.1786,1830.14,820,67,\"SPA, A.5\"\n");
+  const CliRun run = Daylit("sunpos --csv " + (dir / "in.csv").string() + " --out " + (dir / "out.csv").string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const CsvTable table = ReadCsvFile(dir / "out.csv");
+  ASSERT_EQ(table.rows.size(), 1u);
+  EXPECT_EQ(table.rows[0][static_cast<size_t>(table.RequireColumn("note"))], "SPA, A.5");
+  const double apparent = ParseFiniteDouble(table.rows[0][static_cast<size_t>(table.RequireColumn("apparent_zenith_deg"))], "z");
+  EXPECT_NEAR(apparent, 50.111622, 1e-3);
+  // A bad row: exit 2, one line naming file, line and column, and no output file.
+  WriteFileAtomically(dir / "bad.csv", "utc,lat_deg,lon_deg,elev_m\n2026-06-21T10:00:00Z,57,9,0\n2026-06-21T10:00:00Z,123,9,0\n");
+  const CliRun bad = Daylit("sunpos --csv " + (dir / "bad.csv").string() + " --out " + (dir / "bad_out.csv").string());
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("bad.csv:3: latitude_deg: 123 is outside [-90, 90]"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "bad_out.csv"));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 3);  // no temporaries
+  fs::remove_all(dir);
+}
+
+struct BadCall {
+  std::string args;
+  std::string error;  // expected on stderr
+};
+
+TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
+  scene::testing::SceneSandbox sandbox("cli");
+  sandbox.WriteText("broken.json", "{\"format\": \"daylit-recording/1\",");
+  sandbox.WriteText("nan.obj", "o ground\nv 0 0 0\nv 1 nan 0\nv 1 1 0\nf 1 2 3\n");
+  sandbox.json()["model"]["file"] = "nan.obj";
+  const fs::path nan_scene = sandbox.Write();
+  const std::string dir = sandbox.dir().string();
+  const BadCall calls[] = {
+      {"info /no/such/recording", "/no/such/recording: no such file or folder"},
+      {"info " + dir + "/broken.json", "broken.json: invalid JSON"},
+      {"info " + nan_scene.string(), "nan.obj:3: vertex coordinate y is not a finite number ('nan')"},
+      {"sunpos --time 2026-06-21T10:00:00 --lat 57 --lon 9", "--time: time has no zone"},
+      {"sunpos --time 2026-06-21T10:00:00Z --lat 123 --lon 9", "--latitude_deg: 123 is outside [-90, 90]"},
+      {"sunpos --time 2026-06-21T10:00:00Z --lat 57", "--lat and --lon are required"},
+      {"sunpos --csv /no/such.csv", "/no/such.csv: cannot open"},
+      {"sunpos --frobnicate", "frobnicate"},
+  };
+  for (const BadCall& call : calls) {
+    const CliRun run = Daylit(call.args);  // NOLINT
+    EXPECT_EQ(run.exit_code, 2) << call.args;
+    EXPECT_NE(run.err.find(call.error), std::string::npos) << call.args << "\n" << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << call.args << "\n" << run.err;
+    EXPECT_EQ(run.out, "") << call.args;
+  }
+}
+
+}  // namespace
+}  // namespace daylit
