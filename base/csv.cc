@@ -134,15 +134,19 @@ std::string CsvField(std::string_view field) {
   return out;
 }
 
-double ParseFiniteDouble(std::string_view text, std::string_view where) {
+bool TryParseFiniteDouble(std::string_view text, double* value) {
   text = Trim(text);
-  double value = 0.0;
   const char* begin = text.data();
-  if (!text.empty() && text.front() == '+') ++begin;
-  const auto [end, ec] = std::from_chars(begin, text.data() + text.size(), value);
-  if (text.empty() || ec != std::errc() || end != text.data() + text.size() ||
-      !std::isfinite(value)) {
-    ThrowInputError("{}: '{}' is not a finite number", where, text);
+  const char* end = text.data() + text.size();
+  if (begin != end && *begin == '+') ++begin;
+  const auto [ptr, ec] = std::from_chars(begin, end, *value);
+  return begin != end && ec == std::errc() && ptr == end && std::isfinite(*value);
+}
+
+double ParseFiniteDouble(std::string_view text, std::string_view where) {
+  double value = 0.0;
+  if (!TryParseFiniteDouble(text, &value)) {
+    ThrowInputError("{}: '{}' is not a finite number", where, Trim(text));
   }
   return value;
 }

@@ -36,6 +36,10 @@ std::string ReadTextFile(const std::filesystem::path& path);
 // A field as it must be written: quoted when it holds a comma, quote, CR or LF.
 std::string CsvField(std::string_view field);
 
+// Parses a finite decimal number (surrounding blanks and a leading '+' allowed); false if the
+// text is anything else.
+bool TryParseFiniteDouble(std::string_view text, double* value);
+
 // Parses a finite decimal number; throws InputError "<where>: '<text>' is not a finite number".
 double ParseFiniteDouble(std::string_view text, std::string_view where);
 

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <array>
+#include <numeric>
+#include <vector>
 #include <optional>
 
 #include "base/error.h"
@@ -19,11 +21,17 @@ struct Columns {
   int utc, lat, lon, elev, delta_t, dut1, pressure, temp;
 };
 
+// Error locations are formatted only when a value is bad: this runs for every field of every row.
 std::optional<double> OptionalNumber(const CsvTable& table, size_t row, int column,
                                      std::string_view name) {
-  if (column < 0 || table.rows[row][static_cast<size_t>(column)].empty()) return std::nullopt;
-  return ParseFiniteDouble(table.rows[row][static_cast<size_t>(column)],
-                           fmt::format("{}: {}", table.Where(row), name));
+  if (column < 0) return std::nullopt;
+  const std::string& text = table.rows[row][static_cast<size_t>(column)];
+  if (text.empty()) return std::nullopt;
+  double value = 0.0;
+  if (!TryParseFiniteDouble(text, &value)) {
+    ThrowInputError("{}: {}: '{}' is not a finite number", table.Where(row), name, text);
+  }
+  return value;
 }
 
 double RequiredNumber(const CsvTable& table, size_t row, int column, std::string_view name) {
@@ -32,25 +40,57 @@ double RequiredNumber(const CsvTable& table, size_t row, int column, std::string
   return *value;
 }
 
-SunPosition RowSun(const CsvTable& table, size_t row, const Columns& c) {
-  const UtcTime utc = ParseUtcTime(table.rows[row][static_cast<size_t>(c.utc)],
-                                   fmt::format("{}: utc", table.Where(row)));
-  const GeoSite site{RequiredNumber(table, row, c.lat, "lat_deg"),
-                     RequiredNumber(table, row, c.lon, "lon_deg"),
-                     RequiredNumber(table, row, c.elev, "elev_m")};
-  if (const std::string why = site.Check(); !why.empty()) {
-    ThrowInputError("{}: {}", table.Where(row), why);
-  }
-  Atmosphere atmosphere = Atmosphere::Standard(site.elevation_m);
-  if (auto p = OptionalNumber(table, row, c.pressure, "pressure_hpa")) atmosphere.pressure_hpa = *p;
-  if (auto t = OptionalNumber(table, row, c.temp, "temp_c")) atmosphere.temperature_c = *t;
-  if (const std::string why = atmosphere.Check(); !why.empty()) {
-    ThrowInputError("{}: {}", table.Where(row), why);
-  }
+struct RowInput {
+  UtcTime utc;
+  GeoSite site;
+  Atmosphere atmosphere;
   EarthOrientation orientation;
-  orientation.delta_t_s = OptionalNumber(table, row, c.delta_t, "delta_t_s");
-  orientation.dut1_s = OptionalNumber(table, row, c.dut1, "dut1_s");
-  return ComputeSunPosition(utc, site, atmosphere, orientation);
+};
+
+RowInput ParseRow(const CsvTable& table, size_t row, const Columns& c) {
+  RowInput in;
+  const std::string& utc_text = table.rows[row][static_cast<size_t>(c.utc)];
+  std::string parse_error;
+  if (!TryParseUtcTime(utc_text, &in.utc, &parse_error)) {
+    ThrowInputError("{}: utc: {} ('{}')", table.Where(row), parse_error, utc_text);
+  }
+  in.site = {RequiredNumber(table, row, c.lat, "lat_deg"), RequiredNumber(table, row, c.lon, "lon_deg"),
+             RequiredNumber(table, row, c.elev, "elev_m")};
+  if (const std::string why = in.site.Check(); !why.empty()) {
+    ThrowInputError("{}: {}", table.Where(row), why);
+  }
+  const std::optional<double> pressure = OptionalNumber(table, row, c.pressure, "pressure_hpa");
+  const std::optional<double> temperature = OptionalNumber(table, row, c.temp, "temp_c");
+  // The standard atmosphere (two pow calls) only where a value is missing.
+  in.atmosphere = {pressure.value_or(0.0), temperature.value_or(0.0)};
+  if (!pressure || !temperature) {
+    const Atmosphere standard = Atmosphere::Standard(in.site.elevation_m);
+    in.atmosphere = {pressure.value_or(standard.pressure_hpa),
+                     temperature.value_or(standard.temperature_c)};
+  }
+  if (const std::string why = in.atmosphere.Check(); !why.empty()) {
+    ThrowInputError("{}: {}", table.Where(row), why);
+  }
+  in.orientation.delta_t_s = OptionalNumber(table, row, c.delta_t, "delta_t_s");
+  in.orientation.dut1_s = OptionalNumber(table, row, c.dut1, "dut1_s");
+  return in;
+}
+
+// Positions of all rows, computed in time order: ERFA's series evaluate ~1500 sin/cos per call,
+// and glibc's sincos branches on the size of its argument, so rows in random time order
+// mispredict those branches and run ~1.5x slower than the same rows sorted
+// (docs/performance.md).
+std::vector<SunPosition> ComputeInTimeOrder(const std::vector<RowInput>& inputs) {
+  std::vector<size_t> order(inputs.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return inputs[a].utc.SecondsSince(inputs[b].utc) < 0.0;
+  });
+  std::vector<SunPosition> out(inputs.size());
+  for (const size_t i : order) {
+    out[i] = ComputeSunPosition(inputs[i].utc, inputs[i].site, inputs[i].atmosphere, inputs[i].orientation);
+  }
+  return out;
 }
 
 }  // namespace
@@ -71,8 +111,12 @@ std::string ComputeSunposCsv(const CsvTable& input) {
   for (const size_t i : carried) fmt::format_to(std::back_inserter(out), "{},", CsvField(input.header[i]));
   fmt::format_to(std::back_inserter(out), "{},{},{}\n", kOutputColumns[0], kOutputColumns[1],
                  kOutputColumns[2]);
+  std::vector<RowInput> inputs;
+  inputs.reserve(input.rows.size());
+  for (size_t row = 0; row < input.rows.size(); ++row) inputs.push_back(ParseRow(input, row, c));
+  const std::vector<SunPosition> suns = ComputeInTimeOrder(inputs);
   for (size_t row = 0; row < input.rows.size(); ++row) {
-    const SunPosition sun = RowSun(input, row, c);
+    const SunPosition& sun = suns[row];
     for (const size_t i : carried) {
       fmt::format_to(std::back_inserter(out), "{},", CsvField(input.rows[row][i]));
     }
