@@ -1,6 +1,5 @@
 #include <algorithm>
 #include <cmath>
-#include <regex>
 
 #include "base/error.h"
 #include "base/log.h"
@@ -180,8 +179,12 @@ void LoadEnvMap(const JsonField& root, Scene* scene) {
 
 // Checks a printf pattern with exactly one integer conversion (%d or %0Nd) and no other %.
 bool IsFramePattern(const std::string& pattern) {
-  static const std::regex kPattern("^[^%]*%0?[0-9]?d[^%]*$");
-  return std::regex_match(pattern, kPattern);
+  const size_t percent = pattern.find('%');
+  if (percent == std::string::npos || pattern.find('%', percent + 1) != std::string::npos) return false;
+  size_t i = percent + 1;
+  if (i < pattern.size() && pattern[i] == '0') ++i;
+  if (i < pattern.size() && pattern[i] >= '1' && pattern[i] <= '9') ++i;
+  return i < pattern.size() && pattern[i] == 'd';
 }
 
 void LoadFrames(const JsonField& root, Scene* scene) {

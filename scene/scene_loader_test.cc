@@ -145,6 +145,10 @@ const BadScene kBadScenes[] = {
        j["frames"].erase("video");
        j["frames"]["images"] = "frames/%s.png";
      }, "frames.images: 'frames/%s.png' must contain exactly one %d"},
+    {"two conversions in the image pattern", [](auto& j, auto&) {
+       j["frames"].erase("video");
+       j["frames"]["images"] = "frames/%d_%06d.png";
+     }, "frames.images: 'frames/%d_%06d.png' must contain exactly one %d"},
     {"bad response", [](auto& j, auto&) { j["camera"]["response"] = "log"; },
      "camera.response: 'log' is not a response"},
     {"bad distortion", [](auto& j, auto&) { j["camera"]["distortion"] = {0.1, 0.2}; },

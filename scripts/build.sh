@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs what daylit needs (scripts/setup.sh) and builds it.
+#   scripts/build.sh              Release build in build/ (warnings are errors)
+#   scripts/build.sh --sanitize   AddressSanitizer + UBSan build in build-asan/
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+build_dir=build
+cmake_args=(-DCMAKE_BUILD_TYPE=Release -DDAYLIT_WERROR=ON)
+if [ "${1:-}" = "--sanitize" ]; then
+  build_dir=build-asan
+  cmake_args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DDAYLIT_WERROR=ON -DDAYLIT_SANITIZE=ON
+              -DDAYLIT_BUILD_BENCH=OFF)
+fi
+
+bash scripts/setup.sh
+log=$(mktemp /tmp/daylit-configure.XXXXXX.log)
+if ! cmake -S . -B "$build_dir" "${cmake_args[@]}" >"$log" 2>&1; then
+  cat "$log" >&2
+  exit 1
+fi
+rm -f "$log"
+cmake --build "$build_dir" -j "$(nproc)" -- --no-print-directory
+echo "$build_dir"

@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# The main job on a recording (default: the bundled courtyard-a), headless. Sets up and builds
+# first. Writes into OUT (default out/<recording name>/):
+#   info.txt  what `daylit info` says of the recording (validation, frames, sun path, surfaces)
+#   sun.csv   the sun for every frame (topocentric zenith/azimuth and the scene vector)
+# Later parts of the pipeline (bake, estimation, relighting, rendering) join this job as they land.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+recording=${1:-recordings/courtyard-a}
+bash scripts/build.sh >/dev/null
+daylit=build/bin/daylit
+name=$(basename "$(realpath "$recording")")
+out=${2:-out/$name}
+mkdir -p "$out"
+"$daylit" info "$recording" | tee "$out/info.txt.tmp"
+mv "$out/info.txt.tmp" "$out/info.txt"
+"$daylit" sunpos --scene "$recording" --frames --out "$out/sun.csv"
+echo "results in $out/"
