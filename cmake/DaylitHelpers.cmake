@@ -23,13 +23,14 @@ function(daylit_add_library)
   daylit_apply_flags(${ARG_NAME})
 endfunction()
 
-# daylit_add_test(NAME x_test SRCS x_test.cc LINK_LIBS ...): one GoogleTest binary whose
-# tests are registered with ctest under "<folder>/<name>" so `ctest -R sunmodel/` runs one module.
+# daylit_add_test(NAME x_test SRCS x_test.cc LINK_LIBS ... [ENVIRONMENT VAR=value ...]): one
+# GoogleTest binary whose tests are registered with ctest under "<folder>/<name>" so
+# `ctest -R sunmodel/` runs one module.
 function(daylit_add_test)
   if(NOT DAYLIT_BUILD_TESTS)
     return()
   endif()
-  cmake_parse_arguments(ARG "" "NAME" "SRCS;LINK_LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME" "SRCS;LINK_LIBS;ENVIRONMENT" ${ARGN})
   file(RELATIVE_PATH folder ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR})
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LINK_LIBS} GTest::gtest GTest::gtest_main)
@@ -37,5 +38,6 @@ function(daylit_add_test)
     DAYLIT_SOURCE_DIR="${PROJECT_SOURCE_DIR}" DAYLIT_BINARY_DIR="${PROJECT_BINARY_DIR}")
   daylit_apply_flags(${ARG_NAME})
   gtest_discover_tests(${ARG_NAME} TEST_PREFIX "${folder}/${ARG_NAME}." DISCOVERY_TIMEOUT 60
-                       WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+                       WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+                       PROPERTIES ENVIRONMENT "${ARG_ENVIRONMENT}")
 endfunction()

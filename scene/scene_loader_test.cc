@@ -91,6 +91,25 @@ TEST(SceneLoaderTest, PoseFromCorrespondencesMatchesTheGivenPose) {
   EXPECT_NEAR(glm::length(solved.Camera().CenterInWorld() - camera.CenterInWorld()), 0.0, 1e-6);
 }
 
+TEST(SceneLoaderTest, ImageSequenceAndLiveDeviceSources) {
+  SceneSandbox sandbox("images");
+  std::filesystem::create_directories(sandbox.dir() / "frames");
+  sandbox.WriteText("frames/000000.png", "");  // the loader checks only that frame 0 exists
+  sandbox.WriteText("times.csv", "frame,time_utc\n0,2026-06-21T05:00:00Z\n1,2026-06-21T05:00:00.1Z\n");
+  sandbox.json()["frames"] = {{"images", "frames/%06d.png"}, {"timestamps", "times.csv"}};
+  const Scene images = LoadScene(sandbox.Write());
+  EXPECT_EQ(images.frames.kind, FrameSourceKind::kImages);
+  EXPECT_EQ(images.frames.ImagePath(42), sandbox.dir() / "frames/000042.png");
+  EXPECT_EQ(images.frame_times->frames.size(), 2u);
+
+  sandbox.json()["frames"] = {{"device", "/dev/video0"}, {"fps", 25}};
+  const Scene live = LoadScene(sandbox.Write());
+  EXPECT_EQ(live.frames.kind, FrameSourceKind::kDevice);
+  EXPECT_EQ(live.frames.device, "/dev/video0");
+  EXPECT_EQ(live.frames.fps, 25.0);
+  EXPECT_FALSE(live.frame_times.has_value());
+}
+
 struct BadScene {
   const char* what;
   std::function<void(nlohmann::json&, const SceneSandbox&)> edit;

@@ -1,0 +1,74 @@
+#include "relight/sh9.h"
+
+#include <cmath>
+
+#include <glm/gtc/constants.hpp>
+
+namespace daylit::relight {
+namespace {
+
+// Clamped-cosine convolution per band: Â_0, Â_1 (×3), Â_2 (×5).
+constexpr double kPi = glm::pi<double>();
+constexpr std::array<double, 9> kCosineLobe = {kPi,           2.0 * kPi / 3.0, 2.0 * kPi / 3.0,
+                                               2.0 * kPi / 3.0, kPi / 4.0,     kPi / 4.0,
+                                               kPi / 4.0,     kPi / 4.0,       kPi / 4.0};
+
+}  // namespace
+
+Sh9Basis EvalSh9(const glm::dvec3& d) {
+  return {0.282095,
+          0.488603 * d.y,
+          0.488603 * d.z,
+          0.488603 * d.x,
+          1.092548 * d.x * d.y,
+          1.092548 * d.y * d.z,
+          0.315392 * (3.0 * d.z * d.z - 1.0),
+          1.092548 * d.x * d.z,
+          0.546274 * (d.x * d.x - d.y * d.y)};
+}
+
+void ShRgb9::AddRadiance(const glm::dvec3& dir, const glm::dvec3& radiance, double solid_angle_sr) {
+  const Sh9Basis y = EvalSh9(dir);
+  for (size_t i = 0; i < 9; ++i) coefficients[i] += radiance * (y[i] * solid_angle_sr);
+}
+
+glm::dvec3 ShRgb9::Irradiance(const glm::dvec3& n) const {
+  const Sh9Basis y = EvalSh9(n);
+  glm::dvec3 e(0.0);
+  for (size_t i = 0; i < 9; ++i) e += coefficients[i] * (kCosineLobe[i] * y[i]);
+  return e;
+}
+
+glm::dvec3 ShRgb9::Radiance(const glm::dvec3& dir) const {
+  const Sh9Basis y = EvalSh9(dir);
+  glm::dvec3 l(0.0);
+  for (size_t i = 0; i < 9; ++i) l += coefficients[i] * y[i];
+  return l;
+}
+
+glm::dvec3 LatLongDirection(double u, double v, int width, int height) {
+  const double theta = kPi * (v + 0.5) / height;
+  const double alpha = 2.0 * kPi * ((u + 0.5) / width - 0.5);
+  return {std::sin(theta) * std::sin(alpha), std::sin(theta) * std::cos(alpha), std::cos(theta)};
+}
+
+double LatLongTexelSolidAngle(int v, int width, int height) {
+  const double theta0 = kPi * v / height;
+  const double theta1 = kPi * (v + 1) / height;
+  return 2.0 * kPi / width * (std::cos(theta0) - std::cos(theta1));
+}
+
+ShRgb9 ProjectLatLong(const float* rgb, int width, int height) {
+  ShRgb9 sh;
+  for (int v = 0; v < height; ++v) {
+    const double solid_angle = LatLongTexelSolidAngle(v, width, height);
+    for (int u = 0; u < width; ++u) {
+      const float* texel = rgb + (static_cast<size_t>(v) * width + u) * 3;
+      sh.AddRadiance(LatLongDirection(u, v, width, height), glm::dvec3(texel[0], texel[1], texel[2]),
+                     solid_angle);
+    }
+  }
+  return sh;
+}
+
+}  // namespace daylit::relight
