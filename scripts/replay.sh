@@ -3,6 +3,7 @@
 # first. Writes into OUT (default out/<recording name>/):
 #   info.txt  what `daylit info` says of the recording (validation, frames, sun path, surfaces)
 #   sun.csv   the sun for every frame (topocentric zenith/azimuth and the scene vector)
+#   sun.png   the sun's elevation and azimuth over the recording
 # Later parts of the pipeline (bake, estimation, relighting, rendering) join this job as they land.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,5 +15,5 @@ out=${2:-out/$name}
 mkdir -p "$out"
 "$daylit" info "$recording" | tee "$out/info.txt.tmp"
 mv "$out/info.txt.tmp" "$out/info.txt"
-"$daylit" sunpos --scene "$recording" --frames --out "$out/sun.csv"
+"$daylit" sunpos --scene "$recording" --frames --out "$out/sun.csv" --plot "$out/sun.png"
 echo "results in $out/"

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "base/atomic_file.h"
 #include "base/csv.h"
 #include "scene/scene_test_util.h"
@@ -78,12 +80,16 @@ TEST(CliTest, SunposSingleAndSceneVector) {
 
 TEST(CliTest, SunposFramesWritesOneRowPerFrame) {
   const fs::path out = fs::temp_directory_path() / ("daylit_cli_frames_" + std::to_string(::getpid()) + ".csv");
-  const CliRun run = Daylit("sunpos --scene " + kRecording + " --frames --out " + out.string());
+  const fs::path plot = fs::path(out).replace_extension(".png");
+  const CliRun run = Daylit("sunpos --scene " + kRecording + " --frames --out " + out.string() + " --plot " + plot.string());
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const CsvTable table = ReadCsvFile(out);
   fs::remove(out);
   EXPECT_EQ(table.rows.size(), 600u);
   EXPECT_EQ(table.header.back(), "sun_z");
+  const cv::Mat image = cv::imread(plot.string());
+  fs::remove(plot);
+  EXPECT_EQ(image.size(), cv::Size(1200, 640));  // two 1200 x 320 panels
 }
 
 TEST(CliTest, SunposCsvBatchMatchesThePublishedSpaExample) {

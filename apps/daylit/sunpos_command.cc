@@ -9,6 +9,7 @@
 #include "base/csv.h"
 #include "base/error.h"
 #include "base/log.h"
+#include "report/plot.h"
 #include "scene/scene.h"
 #include "sunmodel/geo_frame.h"
 #include "sunmodel/solar_position.h"
@@ -26,6 +27,7 @@ struct SunposOptions {
   bool frames = false;
   std::string csv_in;
   std::string out;
+  std::string plot;
 };
 
 sunmodel::Atmosphere AtmosphereFor(const SunposOptions& o, double elevation_m) {
@@ -55,6 +57,47 @@ void RunBatch(const SunposOptions& o) {
              static_cast<double>(input.rows.size()) / std::max(seconds, 1e-9));
 }
 
+// Elevation and azimuth over the recording's time span (every 5 min, a line) with the frames
+// as dots, against hours (UTC) of the first frame's day.
+void PlotSunPath(const scene::Scene& scene, const sunmodel::Atmosphere& atmosphere, const SunposOptions& o,
+                 const std::string& path) {
+  const std::vector<capture::FrameTime>& frames = scene.frame_times->frames;
+  const UtcTime day_start{frames.front().utc.year, frames.front().utc.month, frames.front().utc.day, 0, 0, 0.0};
+  const auto sun_at = [&](const UtcTime& t) {
+    return sunmodel::ComputeSunPosition(t, scene.location, atmosphere, {o.delta_t_s, o.dut1_s});
+  };
+  report::Series path_elevation{"sun", {}, {}, report::SeriesColor(1), false, false};
+  report::Series path_azimuth{"sun", {}, {}, report::SeriesColor(0), false, false};
+  const double span_s = scene.frame_times->SpanSeconds();
+  for (double t = 0.0; t <= span_s + 1e-9; t += std::min(300.0, std::max(span_s, 1.0) / 2.0)) {
+    UtcTime at = frames.front().utc;
+    at.second += t;  // seconds past 59 are fine for the ephemeris and SecondsSince
+    const sunmodel::SunPosition sun = sun_at(at);
+    path_elevation.x.push_back(at.SecondsSince(day_start) / 3600.0);
+    path_elevation.y.push_back(sun.ApparentElevationDeg());
+    path_azimuth.x.push_back(path_elevation.x.back());
+    path_azimuth.y.push_back(sun.azimuth_deg);
+  }
+  report::Series frame_elevation{"frames", {}, {}, {40, 40, 40}, false, true};
+  report::Series frame_azimuth = frame_elevation;
+  for (const capture::FrameTime& f : frames) {
+    const sunmodel::SunPosition sun = sun_at(f.utc);
+    frame_elevation.x.push_back(f.utc.SecondsSince(day_start) / 3600.0);
+    frame_elevation.y.push_back(sun.ApparentElevationDeg());
+    frame_azimuth.x.push_back(frame_elevation.x.back());
+    frame_azimuth.y.push_back(sun.azimuth_deg);
+  }
+  const std::string date = FormatUtcTime(day_start, 0).substr(0, 10);
+  report::LinePlot top({fmt::format("Sun over {} ({} frames)", scene.name, frames.size()), "",
+                        "apparent elevation, deg", 1200, 320, true});
+  top.Add(std::move(path_elevation));
+  top.Add(std::move(frame_elevation));
+  report::LinePlot bottom({"", fmt::format("hours UTC on {}", date), "azimuth east of north, deg", 1200, 320, false});
+  bottom.Add(std::move(path_azimuth));
+  bottom.Add(std::move(frame_azimuth));
+  report::WritePng(path, {top.Render(), bottom.Render()});
+}
+
 void RunFrames(const SunposOptions& o, const scene::Scene& scene) {
   if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no timestamps", scene.file.string());
   const sunmodel::SceneGeoFrame frame = scene.GeoFrame();
@@ -72,6 +115,10 @@ void RunFrames(const SunposOptions& o, const scene::Scene& scene) {
                    sun.azimuth_deg, sun.ApparentElevationDeg(), d.x, d.y, d.z);
   }
   WriteOrPrint(o.out, fmt::to_string(out));
+  if (!o.plot.empty()) {
+    PlotSunPath(scene, atmosphere, o, o.plot);
+    Log().info("wrote {}", o.plot);
+  }
 }
 
 void RunSingle(const SunposOptions& o, const std::optional<scene::Scene>& scene) {
@@ -135,6 +182,8 @@ void AddSunposCommand(CLI::App& app) {
   auto* frames = cmd->add_flag("--frames", options->frames, "One CSV row per frame of the recording (needs --scene)");
   auto* csv = cmd->add_option("--csv", options->csv_in, "Batch: input CSV file");
   cmd->add_option("--out", options->out, "Output file for --csv or --frames (default: stdout)");
+  auto* plot = cmd->add_option("--plot", options->plot, "With --frames: also write the sun's path as a PNG plot");
+  plot->needs(frames);
   lat->excludes(scene);
   lon->excludes(scene);
   csv->excludes(time)->excludes(lat)->excludes(lon)->excludes(scene)->excludes(frames);

@@ -1,0 +1,153 @@
+#include "report/plot.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "base/atomic_file.h"
+#include "base/error.h"
+
+namespace daylit::report {
+namespace {
+
+constexpr int kLeft = 80, kRight = 20, kTop = 50, kBottom = 48;
+const cv::Scalar kInk(40, 40, 40), kGrid(225, 225, 225);
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+
+cv::Scalar Bgr(const std::array<int, 3>& rgb) { return cv::Scalar(rgb[2], rgb[1], rgb[0]); }
+
+std::string TickLabel(double v, double step) {
+  const int decimals = std::max(0, static_cast<int>(-std::floor(std::log10(step) + 1e-9)));
+  return fmt::format("{:.{}f}", std::abs(v) < step * 1e-6 ? 0.0 : v, decimals);
+}
+
+void DrawDashed(cv::Mat& image, cv::Point a, cv::Point b, const cv::Scalar& color) {
+  const double length = std::hypot(b.x - a.x, b.y - a.y);
+  const int dashes = std::max(1, static_cast<int>(length / 6.0));
+  for (int i = 0; i < dashes; i += 2) {
+    const double t0 = static_cast<double>(i) / dashes, t1 = std::min(1.0, (i + 1.0) / dashes);
+    cv::line(image, a + (b - a) * t0, a + (b - a) * t1, color, 2, cv::LINE_AA);
+  }
+}
+
+}  // namespace
+
+std::array<int, 3> SeriesColor(int index) {
+  static constexpr std::array<std::array<int, 3>, 10> kTab10 = {{{31, 119, 180}, {255, 127, 14}, {44, 160, 44},
+                                                                 {214, 39, 40}, {148, 103, 189}, {140, 86, 75},
+                                                                 {227, 119, 194}, {127, 127, 127}, {188, 189, 34},
+                                                                 {23, 190, 207}}};
+  return kTab10[static_cast<size_t>(index) % kTab10.size()];
+}
+
+std::vector<double> NiceTicks(double lo, double hi, int target) {
+  if (!(hi > lo)) return {lo};
+  const double raw = (hi - lo) / std::max(1, target);
+  const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = magnitude;
+  for (const double m : {1.0, 2.0, 5.0, 10.0}) {
+    step = m * magnitude;
+    if (step >= raw) break;
+  }
+  std::vector<double> ticks;
+  // Integer multiples of the step: no drift from repeated addition.
+  const auto first = static_cast<long long>(std::ceil(lo / step - 1e-9));
+  const auto last = static_cast<long long>(std::floor(hi / step + 1e-9));
+  for (long long k = first; k <= last; ++k) ticks.push_back(static_cast<double>(k) * step);
+  return ticks;
+}
+
+cv::Mat LinePlot::Render() const {
+  cv::Mat image(options_.height, options_.width, CV_8UC3, cv::Scalar(255, 255, 255));
+  double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+  for (const Series& s : series_) {
+    for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
+      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      x0 = std::min(x0, s.x[i]), x1 = std::max(x1, s.x[i]);
+      y0 = std::min(y0, s.y[i]), y1 = std::max(y1, s.y[i]);
+    }
+  }
+  const bool has_data = x0 <= x1;
+  if (!has_data) x0 = 0, x1 = 1, y0 = 0, y1 = 1;
+  if (options_.y_from_zero) y0 = std::min(y0, 0.0), y1 = std::max(y1, 0.0);
+  if (x1 == x0) x0 -= 0.5, x1 += 0.5;
+  if (y1 == y0) y0 -= 0.5, y1 += 0.5;
+  const double pad = 0.05 * (y1 - y0);
+  y0 -= options_.y_from_zero && y0 == 0.0 ? 0.0 : pad;
+  y1 += pad;
+  const cv::Rect area(kLeft, kTop, options_.width - kLeft - kRight, options_.height - kTop - kBottom);
+  const auto to_px = [&](double x, double y) {
+    return cv::Point(area.x + static_cast<int>(std::lround((x - x0) / (x1 - x0) * area.width)),
+                     area.y + area.height - static_cast<int>(std::lround((y - y0) / (y1 - y0) * area.height)));
+  };
+  const std::vector<double> xt = NiceTicks(x0, x1, 10), yt = NiceTicks(y0, y1, 6);
+  const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 1.0, ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
+  for (const double t : yt) {
+    const cv::Point p = to_px(x0, t);
+    cv::line(image, p, {area.x + area.width, p.y}, kGrid, 1);
+    const std::string label = TickLabel(t, ystep);
+    int base = 0;
+    const cv::Size size = cv::getTextSize(label, kFont, 0.45, 1, &base);
+    cv::putText(image, label, {area.x - size.width - 6, p.y + size.height / 2}, kFont, 0.45, kInk, 1, cv::LINE_AA);
+  }
+  for (const double t : xt) {
+    const cv::Point p = to_px(t, y0);
+    cv::line(image, {p.x, area.y}, p, kGrid, 1);
+    const std::string label = TickLabel(t, xstep);
+    int base = 0;
+    const cv::Size size = cv::getTextSize(label, kFont, 0.45, 1, &base);
+    cv::putText(image, label, {p.x - size.width / 2, area.y + area.height + 18}, kFont, 0.45, kInk, 1, cv::LINE_AA);
+  }
+  cv::rectangle(image, area, kInk, 1);
+  for (const Series& s : series_) {
+    const cv::Scalar color = Bgr(s.rgb);
+    if (s.markers_only) {
+      for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
+        if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) cv::circle(image, to_px(s.x[i], s.y[i]), 3, color, cv::FILLED, cv::LINE_AA);
+      }
+      continue;
+    }
+    for (size_t i = 1; i < std::min(s.x.size(), s.y.size()); ++i) {
+      if (!std::isfinite(s.y[i - 1]) || !std::isfinite(s.y[i]) || !std::isfinite(s.x[i - 1]) || !std::isfinite(s.x[i])) continue;
+      if (s.dashed) {
+        DrawDashed(image, to_px(s.x[i - 1], s.y[i - 1]), to_px(s.x[i], s.y[i]), color);
+      } else {
+        cv::line(image, to_px(s.x[i - 1], s.y[i - 1]), to_px(s.x[i], s.y[i]), color, 2, cv::LINE_AA);
+      }
+    }
+  }
+  cv::putText(image, options_.title, {kLeft, 24}, kFont, 0.6, kInk, 1, cv::LINE_AA);
+  cv::putText(image, options_.x_label, {area.x + area.width / 2 - 40, options_.height - 8}, kFont, 0.5, kInk, 1, cv::LINE_AA);
+  cv::putText(image, options_.y_label, {6, kTop - 10}, kFont, 0.45, kInk, 1, cv::LINE_AA);
+  int legend_width = 0;
+  for (const Series& s : series_) {
+    int base = 0;
+    legend_width = std::max(legend_width, cv::getTextSize(s.name, kFont, 0.45, 1, &base).width);
+  }
+  int legend_y = area.y + 18;
+  for (const Series& s : series_) {
+    const int x = area.x + area.width - legend_width - 44;
+    if (s.markers_only) {
+      cv::circle(image, {x + 12, legend_y - 5}, 3, Bgr(s.rgb), cv::FILLED, cv::LINE_AA);
+    } else {
+      cv::line(image, {x, legend_y - 5}, {x + 24, legend_y - 5}, Bgr(s.rgb), 2, cv::LINE_AA);
+    }
+    cv::putText(image, s.name, {x + 30, legend_y}, kFont, 0.45, kInk, 1, cv::LINE_AA);
+    legend_y += 18;
+  }
+  if (!has_data) cv::putText(image, "no data", {area.x + area.width / 2 - 30, area.y + area.height / 2}, kFont, 0.6, kInk, 1);
+  return image;
+}
+
+void WritePng(const std::filesystem::path& path, const std::vector<cv::Mat>& panels) {
+  cv::Mat stacked;
+  cv::vconcat(panels, stacked);
+  std::vector<uchar> png;
+  if (!cv::imencode(".png", stacked, png)) ThrowInputError("{}: cannot encode PNG", path.string());
+  WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+}
+
+}  // namespace daylit::report
