@@ -10,8 +10,8 @@ namespace {
 constexpr double kSecondsPerDay = 86400.0;
 constexpr double kTtMinusTai = 32.184;
 
-// Last year of ERFA's built-in leap-second table that is history rather than extrapolation is
-// the library's; beyond it eraDat keeps the last TAI − UTC (status +1, "dubious year").
+// UTC (and ERFA's TAI − UTC table) starts in 1960. Past the table's end eraDat keeps the last
+// TAI − UTC and returns status +1 ("dubious year"), which we accept.
 constexpr int kFirstUtcYear = 1960;
 
 double Horner(double t, std::initializer_list<double> coefficients_high_first) {
