@@ -1,0 +1,195 @@
+#include "scene/hdr_image.h"
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <half.h>
+
+#include <cmath>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "base/atomic_file.h"
+#include "base/error.h"
+
+namespace daylit::scene {
+namespace {
+
+Imf::PixelType ToImf(ExrPixelType type) {
+  switch (type) {
+    case ExrPixelType::kHalf: return Imf::HALF;
+    case ExrPixelType::kFloat: return Imf::FLOAT;
+    case ExrPixelType::kUint: return Imf::UINT;
+  }
+  return Imf::FLOAT;
+}
+
+// Reads `names` into float planes with OpenEXR's own conversion (missing channels: error).
+ExrChannels ReadPlanes(const std::filesystem::path& path, const std::vector<std::string>& names) {
+  ExrChannels out;
+  Imf::InputFile file(path.c_str());
+  const Imath::Box2i window = file.header().dataWindow();
+  out.width = window.max.x - window.min.x + 1;
+  out.height = window.max.y - window.min.y + 1;
+  const size_t count = static_cast<size_t>(out.width) * out.height;
+  Imf::FrameBuffer frame;
+  out.planes.resize(names.size());
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (file.header().channels().findChannel(names[i]) == nullptr) {
+      ThrowInputError("{}: no channel '{}'", path.string(), names[i]);
+    }
+    out.planes[i].resize(count);
+    // Offset the base so that data window coordinates index the plane from 0.
+    char* base = reinterpret_cast<char*>(out.planes[i].data()) -
+                 (static_cast<ptrdiff_t>(window.min.y) * out.width + window.min.x) * static_cast<ptrdiff_t>(sizeof(float));
+    frame.insert(names[i], Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * static_cast<size_t>(out.width)));
+  }
+  file.setFrameBuffer(frame);
+  file.readPixels(window.min.y, window.max.y);
+  return out;
+}
+
+HdrImage ReadExrRgb(const std::filesystem::path& path) {
+  std::vector<std::string> names;
+  {
+    Imf::InputFile probe(path.c_str());
+    const Imf::ChannelList& channels = probe.header().channels();
+    if (channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B")) {
+      names = {"R", "G", "B"};
+    } else if (channels.findChannel("Y")) {
+      names = {"Y"};
+    } else {
+      ThrowInputError("{}: no R, G, B or Y channels", path.string());
+    }
+  }
+  const ExrChannels planes = ReadPlanes(path, names);
+  HdrImage image{planes.width, planes.height, {}};
+  image.rgb.resize(static_cast<size_t>(image.width) * image.height * 3);
+  for (size_t i = 0; i < static_cast<size_t>(image.width) * image.height; ++i) {
+    for (size_t c = 0; c < 3; ++c) image.rgb[i * 3 + c] = planes.planes[names.size() == 3 ? c : 0][i];
+  }
+  return image;
+}
+
+}  // namespace
+
+HdrImage ReadHdrImage(const std::filesystem::path& path) {
+  if (!std::filesystem::is_regular_file(path)) ThrowInputError("{}: no such file", path.string());
+  if (path.extension() == ".exr") {
+    try {
+      return ReadExrRgb(path);
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::exception& e) {
+      ThrowInputError("{}: not a readable OpenEXR file ({})", path.string(), e.what());
+    }
+  }
+  const cv::Mat bgr = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  if (bgr.empty() || bgr.depth() != CV_32F || bgr.channels() != 3) {
+    ThrowInputError("{}: not a readable Radiance HDR (or OpenEXR) image", path.string());
+  }
+  HdrImage image{bgr.cols, bgr.rows, {}};
+  image.rgb.resize(static_cast<size_t>(image.width) * image.height * 3);
+  for (int y = 0; y < bgr.rows; ++y) {
+    const cv::Vec3f* row = bgr.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < bgr.cols; ++x) {
+      float* p = image.Pixel(x, y);
+      p[0] = row[x][2], p[1] = row[x][1], p[2] = row[x][0];
+    }
+  }
+  return image;
+}
+
+void CheckEnvMap(const HdrImage& image, const std::string& name) {
+  if (image.width != 2 * image.height) {
+    ThrowInputError("{}: {}x{} is not a 2:1 latitude-longitude map", name, image.width, image.height);
+  }
+  size_t non_finite = 0, negative = 0, first = SIZE_MAX;
+  for (size_t i = 0; i < image.rgb.size(); ++i) {
+    const float v = image.rgb[i];
+    const bool bad_value = !std::isfinite(v);
+    const bool below_zero = std::isfinite(v) && v < 0.0f;
+    non_finite += bad_value;
+    negative += below_zero;
+    if ((bad_value || below_zero) && first == SIZE_MAX) first = i / 3;
+  }
+  if (non_finite + negative > 0) {
+    ThrowInputError("{}: {} texel values are NaN or infinite and {} are negative, first at (u {}, v {})", name,
+                    non_finite, negative, first % static_cast<size_t>(image.width), first / static_cast<size_t>(image.width));
+  }
+}
+
+void WriteExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels) {
+  const size_t count = static_cast<size_t>(width) * height;
+  Imf::Header header(width, height);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  Imf::FrameBuffer frame;
+  std::vector<std::vector<half>> halves;  // kHalf channels, converted
+  halves.reserve(channels.size());
+  for (const ExrChannel& c : channels) {
+    header.channels().insert(c.name, Imf::Channel(ToImf(c.type)));
+    if (c.type == ExrPixelType::kUint) {
+      frame.insert(c.name, Imf::Slice(Imf::UINT, reinterpret_cast<char*>(const_cast<uint32_t*>(c.uints)),
+                                      sizeof(uint32_t), sizeof(uint32_t) * static_cast<size_t>(width)));
+    } else if (c.type == ExrPixelType::kHalf) {
+      halves.emplace_back(count);
+      for (size_t i = 0; i < count; ++i) halves.back()[i] = half(c.floats[i]);
+      frame.insert(c.name, Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves.back().data()), sizeof(half),
+                                      sizeof(half) * static_cast<size_t>(width)));
+    } else {
+      frame.insert(c.name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(c.floats)),
+                                      sizeof(float), sizeof(float) * static_cast<size_t>(width)));
+    }
+  }
+  const std::filesystem::path tmp = TemporarySibling(path);
+  try {
+    Imf::OutputFile file(tmp.c_str(), header);
+    file.setFrameBuffer(frame);
+    file.writePixels(height);
+  } catch (const std::exception& e) {
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    ThrowInputError("{}: cannot write OpenEXR ({})", path.string(), e.what());
+  }
+  CommitTemporary(tmp, path);
+}
+
+ExrChannels ReadExrChannels(const std::filesystem::path& path, const std::vector<std::string>& names) {
+  try {
+    return ReadPlanes(path, names);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    ThrowInputError("{}: not a readable OpenEXR file ({})", path.string(), e.what());
+  }
+}
+
+std::vector<uint32_t> ReadExrUintChannel(const std::filesystem::path& path, const std::string& name, int* width,
+                                         int* height) {
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i window = file.header().dataWindow();
+    *width = window.max.x - window.min.x + 1;
+    *height = window.max.y - window.min.y + 1;
+    const Imf::Channel* channel = file.header().channels().findChannel(name);
+    if (channel == nullptr || channel->type != Imf::UINT) {
+      ThrowInputError("{}: no UINT channel '{}'", path.string(), name);
+    }
+    std::vector<uint32_t> data(static_cast<size_t>(*width) * *height);
+    char* base = reinterpret_cast<char*>(data.data()) -
+                 (static_cast<ptrdiff_t>(window.min.y) * *width + window.min.x) * static_cast<ptrdiff_t>(sizeof(uint32_t));
+    Imf::FrameBuffer frame;
+    frame.insert(name, Imf::Slice(Imf::UINT, base, sizeof(uint32_t), sizeof(uint32_t) * static_cast<size_t>(*width)));
+    file.setFrameBuffer(frame);
+    file.readPixels(window.min.y, window.max.y);
+    return data;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    ThrowInputError("{}: not a readable OpenEXR file ({})", path.string(), e.what());
+  }
+}
+
+}  // namespace daylit::scene

@@ -1,0 +1,58 @@
+// Linear HDR images: reading OpenEXR (float, any compression) and Radiance .hdr, writing
+// multi-channel OpenEXR (named layers such as "albedo.R", "V.Y") atomically.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace daylit::scene {
+
+// RGB float image, row-major, row 0 at the top.
+struct HdrImage {
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgb;  // 3 floats per pixel
+
+  const float* Pixel(int x, int y) const { return &rgb[(static_cast<size_t>(y) * width + x) * 3]; }
+  float* Pixel(int x, int y) { return &rgb[(static_cast<size_t>(y) * width + x) * 3]; }
+};
+
+// Reads R, G, B (or Y, as grey) as 32-bit floats from an OpenEXR file, or decodes a Radiance
+// .hdr with OpenCV. Throws InputError naming the file when it cannot be read.
+HdrImage ReadHdrImage(const std::filesystem::path& path);
+
+// Checks an environment map: 2:1, every texel finite and ≥ 0. Throws InputError naming the file,
+// the count of bad texels and the first one ("envmap.exr: 12 texels are NaN or infinite, first at
+// (u 40, v 3)").
+void CheckEnvMap(const HdrImage& image, const std::string& name);
+
+enum class ExrPixelType { kHalf, kFloat, kUint };
+
+// One planar channel to write: `data` points to width·height values of the given type
+// (uint16_t bits for kHalf is not supported: pass floats and kHalf converts).
+struct ExrChannel {
+  std::string name;
+  ExrPixelType type = ExrPixelType::kFloat;
+  const float* floats = nullptr;     // kFloat, kHalf
+  const uint32_t* uints = nullptr;   // kUint
+};
+
+// Writes a multi-channel OpenEXR (ZIP compressed) to a temporary file and renames it to `path`.
+void WriteExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels);
+
+// Reads named channels as floats (UINT channels are converted exactly up to 2^24). Throws
+// InputError naming the file and the missing channel.
+struct ExrChannels {
+  int width = 0;
+  int height = 0;
+  std::vector<std::vector<float>> planes;  // in the order asked
+};
+ExrChannels ReadExrChannels(const std::filesystem::path& path, const std::vector<std::string>& names);
+
+// Reads one UINT channel exactly.
+std::vector<uint32_t> ReadExrUintChannel(const std::filesystem::path& path, const std::string& name,
+                                         int* width, int* height);
+
+}  // namespace daylit::scene

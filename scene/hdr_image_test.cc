@@ -1,0 +1,81 @@
+#include "scene/hdr_image.h"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "base/error.h"
+
+namespace daylit::scene {
+namespace {
+
+std::filesystem::path Temp(const std::string& name) {
+  return std::filesystem::temp_directory_path() / ("daylit_hdr_" + std::to_string(::getpid()) + "_" + name);
+}
+
+TEST(HdrImageTest, ReadsTheBundledEnvMapAsFloats) {
+  const HdrImage env = ReadHdrImage(DAYLIT_SOURCE_DIR "/recordings/courtyard-a/envmap.exr");
+  ASSERT_EQ(env.width, 1024);
+  ASSERT_EQ(env.height, 512);
+  EXPECT_NO_THROW(CheckEnvMap(env, "envmap.exr"));
+  // The sun disc is in the map unclipped: far brighter than half-float's 65504 would matter
+  // for, and far brighter than the sky.
+  float peak = 0.0f;
+  for (const float v : env.rgb) peak = std::max(peak, v);
+  EXPECT_GT(peak, 1000.0f);
+}
+
+TEST(HdrImageTest, MultiChannelExrRoundTripsFloatHalfAndUint) {
+  const int w = 5, h = 3;
+  std::vector<float> a(w * h), b(w * h);
+  std::vector<uint32_t> ids(w * h);
+  for (int i = 0; i < w * h; ++i) a[i] = 1e5f * static_cast<float>(i) + 0.125f, b[i] = 0.5f * static_cast<float>(i), ids[i] = 4000000u + static_cast<uint32_t>(i);
+  const auto path = Temp("layers.exr");
+  WriteExr(path, w, h, {{"point.X", ExrPixelType::kFloat, a.data(), nullptr},
+                        {"V.Y", ExrPixelType::kHalf, b.data(), nullptr},
+                        {"surface", ExrPixelType::kUint, nullptr, ids.data()}});
+  const ExrChannels back = ReadExrChannels(path, {"V.Y", "point.X"});
+  ASSERT_EQ(back.width, w);
+  EXPECT_EQ(back.planes[1], a);  // float: exact
+  EXPECT_EQ(back.planes[0], b);  // halves of these values are exact
+  int rw = 0, rh = 0;
+  EXPECT_EQ(ReadExrUintChannel(path, "surface", &rw, &rh), ids);
+  EXPECT_THROW(ReadExrChannels(path, {"albedo.R"}), InputError);
+  std::filesystem::remove(path);
+}
+
+TEST(HdrImageTest, EnvMapChecksNameTheCause) {
+  HdrImage image{8, 4, std::vector<float>(8 * 4 * 3, 1.0f)};
+  EXPECT_NO_THROW(CheckEnvMap(image, "e.exr"));
+  image.Pixel(3, 2)[1] = NAN;
+  image.Pixel(5, 2)[0] = -1.0f;
+  try {
+    CheckEnvMap(image, "e.exr");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "e.exr: 1 texel values are NaN or infinite and 1 are negative, first at (u 3, v 2)");
+  }
+  HdrImage square{4, 4, std::vector<float>(4 * 4 * 3, 1.0f)};
+  EXPECT_THROW(CheckEnvMap(square, "e.exr"), InputError);
+  EXPECT_THROW(ReadHdrImage(DAYLIT_SOURCE_DIR "/recordings/courtyard-a/model.obj"), InputError);
+}
+
+TEST(HdrImageTest, ReadsRadianceHdr) {
+  // A Radiance file written by OpenCV, read back through the same path users' .hdr probes take.
+  const auto path = Temp("probe.hdr");
+  cv::Mat bgr(2, 4, CV_32FC3, cv::Scalar(0, 0, 0));
+  bgr.at<cv::Vec3f>(0, 1)[2] = 1000.0f;
+  bgr.at<cv::Vec3f>(1, 2)[0] = 0.25f;
+  ASSERT_TRUE(cv::imwrite(path.string(), bgr));
+  const HdrImage back = ReadHdrImage(path);
+  EXPECT_NEAR(back.Pixel(1, 0)[0], 1000.0f, 1000.0f / 128);  // RGBE: 8-bit mantissa
+  EXPECT_NEAR(back.Pixel(2, 1)[2], 0.25f, 0.25f / 128);
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace daylit::scene
