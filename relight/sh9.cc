@@ -4,6 +4,8 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "scene/latlong.h"
+
 namespace daylit::relight {
 namespace {
 
@@ -46,25 +48,13 @@ glm::dvec3 ShRgb9::Radiance(const glm::dvec3& dir) const {
   return l;
 }
 
-glm::dvec3 LatLongDirection(double u, double v, int width, int height) {
-  const double theta = kPi * (v + 0.5) / height;
-  const double alpha = 2.0 * kPi * ((u + 0.5) / width - 0.5);
-  return {std::sin(theta) * std::sin(alpha), std::sin(theta) * std::cos(alpha), std::cos(theta)};
-}
-
-double LatLongTexelSolidAngle(int v, int width, int height) {
-  const double theta0 = kPi * v / height;
-  const double theta1 = kPi * (v + 1) / height;
-  return 2.0 * kPi / width * (std::cos(theta0) - std::cos(theta1));
-}
-
 ShRgb9 ProjectLatLong(const float* rgb, int width, int height) {
   ShRgb9 sh;
   for (int v = 0; v < height; ++v) {
-    const double solid_angle = LatLongTexelSolidAngle(v, width, height);
+    const double solid_angle = scene::LatLongTexelSolidAngle(v, width, height);
     for (int u = 0; u < width; ++u) {
       const float* texel = rgb + (static_cast<size_t>(v) * width + u) * 3;
-      sh.AddRadiance(LatLongDirection(u, v, width, height), glm::dvec3(texel[0], texel[1], texel[2]),
+      sh.AddRadiance(scene::LatLongDirection(u, v, width, height), glm::dvec3(texel[0], texel[1], texel[2]),
                      solid_angle);
     }
   }

@@ -32,13 +32,7 @@ struct ShRgb9 {
 // Y_lm(dir) for the 9 functions above.
 Sh9Basis EvalSh9(const glm::dvec3& dir);
 
-// Direction of texel (u, v) of a W×H latitude-longitude map (docs/design.md): row 0 at the
-// zenith (+Z), the centre column looks along +Y, moving right turns toward +X.
-glm::dvec3 LatLongDirection(double u, double v, int width, int height);
-// Solid angle of one texel of row v: (2π/W)·(cos θ0 − cos θ1).
-double LatLongTexelSolidAngle(int v, int width, int height);
-
-// Projects a W×H lat-long RGB map (row-major, 3 floats per texel) onto SH9.
+// Projects a W×H lat-long RGB map (scene/latlong.h; row-major, 3 floats per texel) onto SH9.
 ShRgb9 ProjectLatLong(const float* rgb, int width, int height);
 
 }  // namespace daylit::relight
