@@ -8,5 +8,6 @@ namespace daylit::app {
 
 void AddSunposCommand(CLI::App& app);
 void AddInfoCommand(CLI::App& app);
+void AddBakeCommand(CLI::App& app);
 
 }  // namespace daylit::app

@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   app.parse_complete_callback([&] { daylit::SetLogVerbosity(verbosity); });
   daylit::app::AddSunposCommand(app);
   daylit::app::AddInfoCommand(app);
+  daylit::app::AddBakeCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,113 @@
+// The offline stage of the relighting pipeline (seed 001, its Fig. 5): from the model, the HDR
+// env map and the calibrated camera, everything each frame needs, so that a frame only does cheap
+// arithmetic. Computed once and cached on disk, keyed by a hash of the inputs.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bake/capture_light.h"
+#include "bake/surface_light.h"
+#include "scene/scene.h"
+
+namespace daylit::bake {
+
+inline constexpr uint32_t kNoSurface = 0xFFFFFFFFu;  // sky, or no point
+inline constexpr const char* kBakeFormat = "daylit-bake/1";
+
+struct BakeOptions {
+  RayOptions rays;
+  int gather_directions = 256;  // per probe, spherical Fibonacci
+
+  bool Check(std::string* why) const;  // ray counts in [16, 65536], offset in (0, 0.1] m
+  std::string Describe() const;        // the values, for the cache key and bake.json
+};
+
+// One value per env-map texel (row-major, like the map).
+struct EnvMapMaps {
+  int width = 0, height = 0;
+  std::vector<glm::vec3> point;       // where the texel's ray from the capture point hits the model
+  std::vector<glm::vec3> normal;      // unit, facing the capture point; 0 for sky
+  std::vector<uint32_t> surface;      // kNoSurface for sky
+  std::vector<float> sky_visibility;  // V; 1 for sky
+  std::vector<glm::vec3> irradiance;  // E at capture time (env map as the light)
+  std::vector<glm::vec3> albedo;      // ρ = π·L / E; 0 for sky and where E ≈ 0
+  std::vector<glm::vec3> radiance;    // the captured radiance L, sun disc removed
+
+  bool IsSky(size_t texel) const { return surface[texel] == kNoSurface; }
+};
+
+// One value per camera pixel (row-major, row 0 at the top).
+struct CameraGBuffer {
+  int width = 0, height = 0;
+  std::vector<glm::vec3> point;
+  std::vector<glm::vec3> normal;      // facing the camera
+  std::vector<uint32_t> surface;      // kNoSurface where the pixel sees no model
+  std::vector<float> sky_visibility;  // V
+  std::vector<glm::vec3> albedo;      // from the env map; the surface's median where hidden from it
+  std::vector<uint32_t> env_texel;    // env texel showing this point, kNoSurface if hidden from the capture point
+  std::vector<uint8_t> diffuse;       // 1: usable to estimate the lighting
+
+  size_t DiffuseCount() const;
+};
+
+// Seed 001's "which pixels of the environment map are used in which key point".
+struct GatherTables {
+  glm::vec3 min{0.0f}, max{0.0f};
+  glm::ivec3 resolution{0};
+  std::vector<glm::vec3> directions;  // SphericalFibonacci(gather_directions)
+  std::vector<uint32_t> texel;        // [probe · directions + d]; probe = (k·ny + j)·nx + i
+
+  size_t ProbeCount() const { return static_cast<size_t>(resolution.x) * resolution.y * resolution.z; }
+  glm::vec3 ProbePosition(int i, int j, int k) const;
+};
+
+struct SurfaceAlbedo {
+  std::string surface;
+  glm::vec3 albedo{0.0f};  // per-channel median over the surface's env texels
+  size_t texels = 0;
+};
+
+struct SceneBake {
+  std::string hash;
+  CaptureSun capture_sun;
+  EnvMapMaps env;
+  CameraGBuffer camera;
+  GatherTables gather;  // empty when the scene has no volume
+  std::vector<SurfaceAlbedo> albedo_table;
+};
+
+// The cache key: inputs that change the bake (scene.json, model, env map, diffuse mask, options,
+// format), hashed (FNV-1a 64, hex).
+std::string BakeHash(const scene::Scene& scene, const BakeOptions& options);
+
+// Computes the whole bake, with a progress bar. Throws InputError for an env map that is not 2:1 or
+// has NaN/Inf/negative texels, a capture point inside the model, or a camera that sees no diffuse
+// surface; warns about degenerate triangles.
+SceneBake RunBake(const scene::Scene& scene, const BakeOptions& options);
+
+// Writes the bake into `dir`: env_maps.exr, camera_gbuffer.exr, gather.exr (multi-layer OpenEXR),
+// albedo.csv, bake.json and PNG previews. Each file is written to a temporary name and renamed;
+// bake.json last, so an interrupted save is never taken for a complete one.
+void SaveBake(const SceneBake& bake, const scene::Scene& scene, const BakeOptions& options,
+              const std::filesystem::path& dir);
+
+// Loads a bake from `dir` if its bake.json carries `hash`; nullopt when missing or stale.
+std::optional<SceneBake> LoadBake(const std::filesystem::path& dir, const std::string& hash);
+
+// `dir` if given, else $XDG_CACHE_HOME/daylit/<scene name> (~/.cache/daylit/<name>).
+std::filesystem::path CacheDir(const scene::Scene& scene, const std::optional<std::filesystem::path>& dir);
+
+// The cached bake when its hash matches, else a new one (saved). `loaded` tells which.
+SceneBake BakeOrLoad(const scene::Scene& scene, const BakeOptions& options, const std::filesystem::path& dir,
+                     bool* loaded);
+
+// albedo.csv: `surface,r,g,b,pixels` (pixels: the env-map texels behind the median).
+std::string AlbedoCsv(const std::vector<SurfaceAlbedo>& table);
+
+}  // namespace daylit::bake

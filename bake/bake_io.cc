@@ -1,0 +1,277 @@
+// Storing and loading the bake: the cache key, multi-layer EXRs, bake.json, albedo.csv, previews.
+#include <cstdlib>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "bake/bake.h"
+#include "bake/sampling.h"
+#include "base/atomic_file.h"
+#include "base/csv.h"
+#include "base/error.h"
+#include "base/log.h"
+#include "capture/response.h"
+#include "report/plot.h"
+#include "scene/hdr_image.h"
+
+namespace daylit::bake {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Fnv1a {
+  uint64_t state = 14695981039346656037ull;
+  void Add(std::string_view bytes) {
+    for (const char c : bytes) state = (state ^ static_cast<uint8_t>(c)) * 1099511628211ull;
+  }
+  void AddFile(const fs::path& path) {
+    Add(path.filename().string());
+    Add(ReadTextFile(path));
+  }
+};
+
+// Planar copies of one component of a vector field, for EXR slices.
+std::vector<float> Component(const std::vector<glm::vec3>& v, int c) {
+  std::vector<float> out(v.size());
+  for (size_t i = 0; i < v.size(); ++i) out[i] = v[i][c];
+  return out;
+}
+
+std::vector<glm::vec3> Gather3(const scene::ExrChannels& ch, size_t first) {
+  std::vector<glm::vec3> out(ch.planes[first].size());
+  for (size_t i = 0; i < out.size(); ++i) out[i] = {ch.planes[first][i], ch.planes[first + 1][i], ch.planes[first + 2][i]};
+  return out;
+}
+
+// Writes `fields` (name prefix -> RGB/XYZ vectors) plus scalars as one multi-layer EXR.
+struct Layers {
+  std::vector<std::vector<float>> storage;
+  std::vector<scene::ExrChannel> channels;
+  void Vec3(const std::string& prefix, const char* suffixes, const std::vector<glm::vec3>& v, scene::ExrPixelType type) {
+    for (int c = 0; c < 3; ++c) {
+      storage.push_back(Component(v, c));
+      channels.push_back({prefix + "." + suffixes[c], type, nullptr, nullptr});
+    }
+  }
+  void Scalar(const std::string& name, const std::vector<float>& v, scene::ExrPixelType type) {
+    storage.push_back(v);
+    channels.push_back({name, type, nullptr, nullptr});
+  }
+  void Uint(const std::string& name, const std::vector<uint32_t>& v) {
+    channels.push_back({name, scene::ExrPixelType::kUint, nullptr, v.data()});
+  }
+  void Write(const fs::path& path, int width, int height) {
+    size_t k = 0;
+    for (scene::ExrChannel& c : channels) {
+      if (c.type != scene::ExrPixelType::kUint) c.floats = storage[k++].data();
+    }
+    scene::WriteExr(path, width, height, channels);
+  }
+};
+
+cv::Mat ToPreview(int width, int height, const std::function<glm::vec3(size_t)>& rgb_linear, bool encode_srgb) {
+  cv::Mat image(height, width, CV_8UC3);
+  const capture::CameraResponse srgb;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const glm::vec3 c = rgb_linear(static_cast<size_t>(y) * width + x);
+      cv::Vec3b& p = image.at<cv::Vec3b>(y, x);
+      for (int k = 0; k < 3; ++k) {
+        const double v = encode_srgb ? srgb.ToEncoded(c[k]) : std::clamp(static_cast<double>(c[k]), 0.0, 1.0);
+        p[2 - k] = static_cast<uint8_t>(std::lround(255.0 * v));
+      }
+    }
+  }
+  return image;
+}
+
+glm::vec3 SurfaceColor(uint32_t surface) {
+  if (surface == kNoSurface) return glm::vec3(0.55f, 0.75f, 1.0f);
+  const std::array<int, 3> c = report::SeriesColor(static_cast<int>(surface));
+  return glm::vec3(c[0], c[1], c[2]) / 255.0f;
+}
+
+void WritePreviews(const SceneBake& bake, const fs::path& dir) {
+  const EnvMapMaps& e = bake.env;
+  const CameraGBuffer& g = bake.camera;
+  const auto png = [&](const char* name, const cv::Mat& image) { report::WritePng(dir / name, {image}); };
+  png("env_albedo.png", ToPreview(e.width, e.height, [&](size_t i) { return e.albedo[i]; }, true));
+  png("env_sky_visibility.png", ToPreview(e.width, e.height, [&](size_t i) { return glm::vec3(e.sky_visibility[i]); }, false));
+  png("env_surfaces.png", ToPreview(e.width, e.height, [&](size_t i) { return SurfaceColor(e.surface[i]); }, false));
+  png("env_normals.png", ToPreview(e.width, e.height, [&](size_t i) { return 0.5f * e.normal[i] + 0.5f; }, false));
+  png("camera_albedo.png", ToPreview(g.width, g.height, [&](size_t i) { return g.albedo[i]; }, true));
+  png("camera_sky_visibility.png", ToPreview(g.width, g.height, [&](size_t i) { return glm::vec3(g.sky_visibility[i]); }, false));
+  png("camera_surfaces.png", ToPreview(g.width, g.height, [&](size_t i) { return SurfaceColor(g.surface[i]); }, false));
+  png("camera_diffuse.png", ToPreview(g.width, g.height, [&](size_t i) {
+        return g.diffuse[i] ? glm::vec3(1.0f) : g.surface[i] == kNoSurface ? glm::vec3(0.0f) : glm::vec3(0.3f);
+      }, false));
+}
+
+nlohmann::json Vec(const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+glm::vec3 Vec(const nlohmann::json& j) { return {j[0].get<float>(), j[1].get<float>(), j[2].get<float>()}; }
+
+}  // namespace
+
+std::string BakeHash(const scene::Scene& scene, const BakeOptions& options) {
+  Fnv1a h;
+  h.Add(kBakeFormat);
+  h.Add(options.Describe());
+  h.AddFile(scene.file);
+  h.AddFile(scene.model.file);
+  if (scene.envmap) h.AddFile(scene.envmap->file);
+  if (scene.diffuse_mask) h.AddFile(*scene.diffuse_mask);
+  return fmt::format("{:016x}", h.state);
+}
+
+std::string AlbedoCsv(const std::vector<SurfaceAlbedo>& table) {
+  std::string out = "surface,r,g,b,pixels\n";
+  for (const SurfaceAlbedo& row : table) {
+    out += fmt::format("{},{:.4f},{:.4f},{:.4f},{}\n", CsvField(row.surface), row.albedo.x, row.albedo.y, row.albedo.z,
+                       row.texels);
+  }
+  return out;
+}
+
+fs::path CacheDir(const scene::Scene& scene, const std::optional<fs::path>& dir) {
+  if (dir) return *dir;
+  const char* xdg = std::getenv("XDG_CACHE_HOME");
+  const char* home = std::getenv("HOME");
+  const fs::path base = xdg != nullptr && *xdg != '\0' ? fs::path(xdg)
+                        : home != nullptr && *home != '\0' ? fs::path(home) / ".cache"
+                                                            : fs::temp_directory_path();
+  return base / "daylit" / scene.name;
+}
+
+void SaveBake(const SceneBake& bake, const scene::Scene& scene, const BakeOptions& options, const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) ThrowInputError("{}: cannot create the cache folder: {}", dir.string(), ec.message());
+  fs::remove(dir / "bake.json", ec);  // stale until the new one is complete
+  using T = scene::ExrPixelType;
+  {
+    const EnvMapMaps& e = bake.env;
+    Layers layers;
+    layers.Vec3("point", "XYZ", e.point, T::kFloat);
+    layers.Vec3("normal", "XYZ", e.normal, T::kHalf);
+    layers.Uint("surface", e.surface);
+    layers.Scalar("V.Y", e.sky_visibility, T::kHalf);
+    layers.Vec3("E", "RGB", e.irradiance, T::kFloat);
+    layers.Vec3("albedo", "RGB", e.albedo, T::kHalf);
+    layers.Vec3("L", "RGB", e.radiance, T::kFloat);
+    layers.Write(dir / "env_maps.exr", e.width, e.height);
+  }
+  {
+    const CameraGBuffer& g = bake.camera;
+    Layers layers;
+    layers.Vec3("point", "XYZ", g.point, T::kFloat);
+    layers.Vec3("normal", "XYZ", g.normal, T::kHalf);
+    layers.Uint("surface", g.surface);
+    layers.Scalar("V.Y", g.sky_visibility, T::kHalf);
+    layers.Vec3("albedo", "RGB", g.albedo, T::kHalf);
+    layers.Uint("env_texel", g.env_texel);
+    layers.Scalar("diffuse.Y", std::vector<float>(g.diffuse.begin(), g.diffuse.end()), T::kHalf);
+    layers.Write(dir / "camera_gbuffer.exr", g.width, g.height);
+  }
+  if (!bake.gather.texel.empty()) {
+    Layers layers;
+    layers.Uint("texel", bake.gather.texel);
+    layers.Write(dir / "gather.exr", static_cast<int>(bake.gather.directions.size()), static_cast<int>(bake.gather.ProbeCount()));
+  }
+  WriteFileAtomically(dir / "albedo.csv", AlbedoCsv(bake.albedo_table));
+  WritePreviews(bake, dir);
+  nlohmann::json j;
+  j["format"] = kBakeFormat;
+  j["hash"] = bake.hash;
+  j["scene"] = fs::absolute(scene.file).string();
+  j["options"] = options.Describe();
+  j["capture_sun"] = {{"direction", Vec(bake.capture_sun.dir)},
+                      {"above_horizon", bake.capture_sun.above_horizon},
+                      {"dni_rgb", Vec(bake.capture_sun.dni_rgb)},
+                      {"dni_from_map_rgb", Vec(bake.capture_sun.dni_from_map_rgb)},
+                      {"disc_texels", bake.capture_sun.disc_texels},
+                      {"brightest_offset_deg", bake.capture_sun.brightest_offset_deg}};
+  j["camera"] = {{"width", bake.camera.width}, {"height", bake.camera.height}, {"diffuse_pixels", bake.camera.DiffuseCount()}};
+  j["gather"] = {{"min", Vec(bake.gather.min)},
+                 {"max", Vec(bake.gather.max)},
+                 {"resolution", {bake.gather.resolution.x, bake.gather.resolution.y, bake.gather.resolution.z}},
+                 {"directions", bake.gather.directions.size()}};
+  WriteFileAtomically(dir / "bake.json", j.dump(1) + "\n");
+}
+
+std::optional<SceneBake> LoadBake(const fs::path& dir, const std::string& hash) {
+  if (!fs::is_regular_file(dir / "bake.json")) return std::nullopt;
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(ReadTextFile(dir / "bake.json"));
+    if (j.value("format", "") != kBakeFormat || j.value("hash", "") != hash) return std::nullopt;
+  } catch (const nlohmann::json::exception&) {
+    return std::nullopt;
+  }
+  SceneBake bake;
+  bake.hash = hash;
+  const auto& sun = j["capture_sun"];
+  bake.capture_sun.dir = Vec(sun["direction"]);
+  bake.capture_sun.above_horizon = sun["above_horizon"].get<bool>();
+  bake.capture_sun.dni_rgb = Vec(sun["dni_rgb"]);
+  bake.capture_sun.dni_from_map_rgb = Vec(sun["dni_from_map_rgb"]);
+  bake.capture_sun.disc_texels = sun["disc_texels"].get<size_t>();
+  bake.capture_sun.brightest_offset_deg = sun["brightest_offset_deg"].get<double>();
+  {
+    const scene::ExrChannels ch = scene::ReadExrChannels(
+        dir / "env_maps.exr", {"point.X", "point.Y", "point.Z", "normal.X", "normal.Y", "normal.Z", "V.Y", "E.R", "E.G",
+                               "E.B", "albedo.R", "albedo.G", "albedo.B", "L.R", "L.G", "L.B"});
+    EnvMapMaps& e = bake.env;
+    e.width = ch.width, e.height = ch.height;
+    e.point = Gather3(ch, 0), e.normal = Gather3(ch, 3), e.sky_visibility = ch.planes[6];
+    e.irradiance = Gather3(ch, 7), e.albedo = Gather3(ch, 10), e.radiance = Gather3(ch, 13);
+    int w = 0, h = 0;
+    e.surface = scene::ReadExrUintChannel(dir / "env_maps.exr", "surface", &w, &h);
+  }
+  {
+    const scene::ExrChannels ch = scene::ReadExrChannels(
+        dir / "camera_gbuffer.exr", {"point.X", "point.Y", "point.Z", "normal.X", "normal.Y", "normal.Z", "V.Y",
+                                     "albedo.R", "albedo.G", "albedo.B", "diffuse.Y"});
+    CameraGBuffer& g = bake.camera;
+    g.width = ch.width, g.height = ch.height;
+    g.point = Gather3(ch, 0), g.normal = Gather3(ch, 3), g.sky_visibility = ch.planes[6], g.albedo = Gather3(ch, 7);
+    g.diffuse.resize(ch.planes[10].size());
+    for (size_t i = 0; i < g.diffuse.size(); ++i) g.diffuse[i] = ch.planes[10][i] > 0.5f ? 1 : 0;
+    int w = 0, h = 0;
+    g.surface = scene::ReadExrUintChannel(dir / "camera_gbuffer.exr", "surface", &w, &h);
+    g.env_texel = scene::ReadExrUintChannel(dir / "camera_gbuffer.exr", "env_texel", &w, &h);
+  }
+  const auto& gather = j["gather"];
+  bake.gather.min = Vec(gather["min"]);
+  bake.gather.max = Vec(gather["max"]);
+  bake.gather.resolution = {gather["resolution"][0].get<int>(), gather["resolution"][1].get<int>(), gather["resolution"][2].get<int>()};
+  const int directions = gather["directions"].get<int>();
+  if (directions > 0) {
+    bake.gather.directions = SphericalFibonacci(directions);
+    int w = 0, h = 0;
+    bake.gather.texel = scene::ReadExrUintChannel(dir / "gather.exr", "texel", &w, &h);
+  }
+  const CsvTable albedo = ReadCsvFile(dir / "albedo.csv");
+  for (size_t r = 0; r < albedo.rows.size(); ++r) {
+    const auto& row = albedo.rows[r];
+    bake.albedo_table.push_back({row[0],
+                                 glm::vec3(ParseFiniteDouble(row[1], albedo.Where(r)), ParseFiniteDouble(row[2], albedo.Where(r)),
+                                           ParseFiniteDouble(row[3], albedo.Where(r))),
+                                 static_cast<size_t>(ParseFiniteDouble(row[4], albedo.Where(r)))});
+  }
+  return bake;
+}
+
+SceneBake BakeOrLoad(const scene::Scene& scene, const BakeOptions& options, const fs::path& dir, bool* loaded) {
+  const std::string hash = BakeHash(scene, options);
+  if (std::optional<SceneBake> cached = LoadBake(dir, hash)) {
+    *loaded = true;
+    return std::move(*cached);
+  }
+  *loaded = false;
+  SceneBake bake = RunBake(scene, options);
+  SaveBake(bake, scene, options, dir);
+  return bake;
+}
+
+}  // namespace daylit::bake

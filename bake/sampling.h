@@ -1,0 +1,26 @@
+// Deterministic ray directions for integrals over hemispheres and spheres.
+#pragma once
+
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace daylit::bake {
+
+// `count` cosine-weighted directions about +Z from a Hammersley point set (stratified: the
+// error of a smooth integral falls much faster than 1/sqrt(count)). Averaging f over them
+// estimates (1/π) ∫ f(ω) cos θ dω.
+std::vector<glm::vec3> CosineHemisphere(int count);
+
+// An orthonormal basis whose third axis is the unit vector `n` (Duff et al. 2017, "Building an
+// Orthonormal Basis, Revisited"); columns t, b, n.
+glm::mat3 BasisAround(const glm::vec3& n);
+
+// `count` nearly uniform unit directions over the sphere (spherical Fibonacci lattice).
+std::vector<glm::vec3> SphericalFibonacci(int count);
+
+// A rotation angle in [0, 2π) from an integer key (hash), to decorrelate the sample patterns of
+// neighbouring points (Cranley-Patterson rotation about the normal).
+float RotationOf(uint32_t key);
+
+}  // namespace daylit::bake

@@ -1,0 +1,49 @@
+// Light at points of the model by ray casting (Embree): the cosine-weighted sky visibility V,
+// the irradiance at env-map capture time with the env map itself as the light (for albedo by
+// inverse rendering), and the per-frame sun visibility s.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bake/capture_light.h"
+#include "base/progress.h"
+#include "scene/hdr_image.h"
+#include "scene/raycaster.h"
+
+namespace daylit::bake {
+
+struct RayOptions {
+  int hemisphere_rays = 256;  // per point, stratified cosine-weighted: V within 0.01 (tests)
+  float offset_m = 2e-3f;     // ray origins are moved this far along the normal (self-hits)
+};
+
+// What the scene looked like at capture time.
+struct CaptureScene {
+  const scene::RayCaster* caster = nullptr;
+  const scene::HdrImage* env = nullptr;  // captured radiance, sun disc removed
+  const scene::HdrImage* sky = nullptr;  // SkyOnly(env): sky radiance in every direction
+  glm::vec3 capture_position{0.0f};
+  CaptureSun sun;
+};
+
+// For each point (unit normal facing its visible side): V = share of cosine-weighted rays that
+// reach the sky, and E = E_sun·s·max(0, n·l) + π·mean(L_in), where L_in is the sky's radiance
+// for rays that escape and, for rays that hit the model at y, y's radiance in the env map (the
+// texel toward y from the capture position: one bounce). Parallel over points.
+void IntegrateCaptureIrradiance(const CaptureScene& capture, const RayOptions& options, const glm::vec3* points,
+                                const glm::vec3* normals, size_t count, float* sky_visibility, glm::vec3* irradiance,
+                                Progress* progress);
+
+// V alone, with occlusion rays (cheaper than IntegrateCaptureIrradiance).
+void SkyVisibility(const scene::RayCaster& caster, const RayOptions& options, const glm::vec3* points,
+                   const glm::vec3* normals, size_t count, float* sky_visibility, Progress* progress);
+
+// Sun visibility s ∈ {0, 1} toward unit `sun_dir`: 0 where the normal faces away or a shadow ray
+// hits the model. This is what the online stages re-run when the sun has moved.
+void SunVisibility(const scene::RayCaster& caster, const glm::vec3* points, const glm::vec3* normals, size_t count,
+                   const glm::vec3& sun_dir, float offset_m, uint8_t* visible);
+
+}  // namespace daylit::bake
