@@ -52,6 +52,31 @@ void CheckCapturePosition(const scene::Scene& scene, const std::vector<scene::Ra
   }
 }
 
+// Per surface: median albedo π·L/E and median indirect irradiance E − E_sun over its texels.
+HiddenSurfaceModel SurfaceModelFrom(const scene::SceneModel& model, const std::vector<glm::vec3>& radiance,
+                                    const std::vector<size_t>& texels, const std::vector<uint32_t>& surface,
+                                    const std::vector<glm::vec3>& irradiance, const std::vector<glm::vec3>& direct) {
+  const size_t surfaces = model.surface_names.size();
+  std::vector<std::array<std::vector<float>, 6>> values(surfaces);
+  for (size_t i = 0; i < texels.size(); ++i) {
+    auto& v = values[surface[texels[i]]];
+    for (int c = 0; c < 3; ++c) {
+      if (irradiance[i][c] > 1e-6f) v[static_cast<size_t>(c)].push_back(glm::pi<float>() * radiance[texels[i]][c] / irradiance[i][c]);
+      v[3 + static_cast<size_t>(c)].push_back(irradiance[i][c] - direct[i][c]);
+    }
+  }
+  HiddenSurfaceModel hidden;
+  hidden.albedo.assign(surfaces, glm::vec3(0.0f));
+  hidden.indirect.assign(surfaces, glm::vec3(0.0f));
+  for (size_t s = 0; s < surfaces; ++s) {
+    for (int c = 0; c < 3; ++c) {
+      hidden.albedo[s][c] = Median(&values[s][static_cast<size_t>(c)]);
+      hidden.indirect[s][c] = Median(&values[s][3 + static_cast<size_t>(c)]);
+    }
+  }
+  return hidden;
+}
+
 EnvMapMaps ComputeEnvMapMaps(const scene::Scene& scene, const scene::RayCaster& caster, const BakeOptions& options,
                              scene::HdrImage* env, CaptureSun* sun) {
   const std::string name = scene.envmap->file.string();
@@ -93,17 +118,31 @@ EnvMapMaps ComputeEnvMapMaps(const scene::Scene& scene, const scene::RayCaster& 
     surface_texels.push_back(t);
   }
   const scene::HdrImage sky = SkyOnly(*env, is_sky, sun->dir);
-  const CaptureScene capture_scene{&caster, env, &sky, capture, *sun};
-  std::vector<glm::vec3> points(surface_texels.size()), normals(surface_texels.size()), e(surface_texels.size());
+  std::vector<float> env_distance(n, -1.0f);
+  for (size_t t = 0; t < n; ++t) env_distance[t] = hits[t].IsHit() ? hits[t].t : -1.0f;
+  std::vector<glm::vec3> points(surface_texels.size()), normals(surface_texels.size()), e(surface_texels.size()),
+      direct(surface_texels.size());
   std::vector<float> v(surface_texels.size());
   for (size_t i = 0; i < surface_texels.size(); ++i) {
     points[i] = maps.point[surface_texels[i]];
     normals[i] = maps.normal[surface_texels[i]];
   }
+  // Pass 1, coarse: each surface's albedo and typical indirect light, for the points that the
+  // capture point cannot see (pass 2 needs their radiance and the map shows what hides them).
+  CaptureScene capture_scene{&caster, env, &sky, &env_distance, &maps.surface, nullptr, capture, *sun};
+  RayOptions coarse = options.rays;
+  coarse.hemisphere_rays = std::max(16, options.rays.hemisphere_rays / 4);
   {
-    Progress progress("bake: env-map light  ", points.size());
+    Progress progress("bake: env light, 1/2 ", points.size());
+    IntegrateCaptureIrradiance(capture_scene, coarse, points.data(), normals.data(), points.size(), v.data(), e.data(),
+                               direct.data(), &progress);
+  }
+  const HiddenSurfaceModel hidden = SurfaceModelFrom(scene.model, maps.radiance, surface_texels, maps.surface, e, direct);
+  capture_scene.hidden = &hidden;
+  {
+    Progress progress("bake: env light, 2/2 ", points.size());
     IntegrateCaptureIrradiance(capture_scene, options.rays, points.data(), normals.data(), points.size(), v.data(),
-                               e.data(), &progress);
+                               e.data(), nullptr, &progress);
   }
   for (size_t i = 0; i < surface_texels.size(); ++i) {
     const size_t t = surface_texels[i];
@@ -209,6 +248,9 @@ CameraGBuffer ComputeCameraGBuffer(const scene::Scene& scene, const scene::RayCa
                     : 0;
     }
   });
+  std::vector<uint8_t> has_point(n, 0);
+  for (const size_t i : hit_pixels) has_point[i] = 1;
+  const std::vector<glm::vec3> detail = CameraTextureDetail(scene, g.point, has_point, env.height, options.detail);
   std::vector<uint8_t> is_diffuse_surface(scene.model.surface_names.size(), 0);
   for (const int s : scene.diffuse_surfaces) is_diffuse_surface[static_cast<size_t>(s)] = 1;
   for (size_t k = 0; k < hit_pixels.size(); ++k) {
@@ -218,9 +260,9 @@ CameraGBuffer ComputeCameraGBuffer(const scene::Scene& scene, const scene::RayCa
     if (seen[k]) {
       const glm::dvec2 uv = scene::LatLongCoordinates(toward, env.width, env.height);
       g.env_texel[i] = static_cast<uint32_t>(scene::LatLongTexel(toward, env.width, env.height));
-      g.albedo[i] = EnvAlbedoAt(env, uv, g.surface[i]);
+      g.albedo[i] = EnvAlbedoAt(env, uv, g.surface[i]) * detail[i];
     } else {
-      g.albedo[i] = albedo_table[g.surface[i]].albedo;
+      g.albedo[i] = albedo_table[g.surface[i]].albedo * detail[i];
     }
     bool usable = is_diffuse_surface[g.surface[i]] != 0;
     if (!diffuse_mask.empty()) {
@@ -296,8 +338,8 @@ bool BakeOptions::Check(std::string* why) const {
 }
 
 std::string BakeOptions::Describe() const {
-  return fmt::format("hemisphere_rays={} offset_m={} gather_directions={}", rays.hemisphere_rays, rays.offset_m,
-                     gather_directions);
+  return fmt::format("hemisphere_rays={} offset_m={} gather_directions={} detail_frames={} detail_footprint={}",
+                     rays.hemisphere_rays, rays.offset_m, gather_directions, detail.frames, detail.footprint_scale);
 }
 
 size_t CameraGBuffer::DiffuseCount() const {

@@ -13,16 +13,19 @@
 
 #include "bake/capture_light.h"
 #include "bake/surface_light.h"
+#include "bake/texture_detail.h"
 #include "scene/scene.h"
 
 namespace daylit::bake {
 
 inline constexpr uint32_t kNoSurface = 0xFFFFFFFFu;  // sky, or no point
-inline constexpr const char* kBakeFormat = "daylit-bake/1";
+// Bumped whenever the bake computes something differently, so that old caches are re-baked.
+inline constexpr const char* kBakeFormat = "daylit-bake/2";
 
 struct BakeOptions {
   RayOptions rays;
   int gather_directions = 256;  // per probe, spherical Fibonacci
+  DetailOptions detail;         // camera albedo detail from the recording's frames
 
   bool Check(std::string* why) const;  // ray counts in [16, 65536], offset in (0, 0.1] m
   std::string Describe() const;        // the values, for the cache key and bake.json
@@ -49,7 +52,8 @@ struct CameraGBuffer {
   std::vector<glm::vec3> normal;      // facing the camera
   std::vector<uint32_t> surface;      // kNoSurface where the pixel sees no model
   std::vector<float> sky_visibility;  // V
-  std::vector<glm::vec3> albedo;      // from the env map; the surface's median where hidden from it
+  std::vector<glm::vec3> albedo;      // env map albedo × texture detail from the frames (the
+                                      // surface's median × detail where hidden from the capture point)
   std::vector<uint32_t> env_texel;    // env texel showing this point, kNoSurface if hidden from the capture point
   std::vector<uint8_t> diffuse;       // 1: usable to estimate the lighting
 
@@ -82,8 +86,8 @@ struct SceneBake {
   std::vector<SurfaceAlbedo> albedo_table;
 };
 
-// The cache key: inputs that change the bake (scene.json, model, env map, diffuse mask, options,
-// format), hashed (FNV-1a 64, hex).
+// The cache key: inputs that change the bake (scene.json, model, env map, diffuse mask, the
+// frames the detail comes from, options, format), hashed (FNV-1a 64, hex).
 std::string BakeHash(const scene::Scene& scene, const BakeOptions& options);
 
 // Computes the whole bake, with a progress bar. Throws InputError for an env map that is not 2:1 or

@@ -121,6 +121,8 @@ std::string BakeHash(const scene::Scene& scene, const BakeOptions& options) {
   h.AddFile(scene.model.file);
   if (scene.envmap) h.AddFile(scene.envmap->file);
   if (scene.diffuse_mask) h.AddFile(*scene.diffuse_mask);
+  if (options.detail.frames > 0 && scene.frames.kind == scene::FrameSourceKind::kVideo) h.AddFile(scene.frames.video);
+  if (scene.frame_times) h.AddFile(scene.frame_times->file);
   return fmt::format("{:016x}", h.state);
 }
 

@@ -8,6 +8,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include "bake/sampling.h"
+#include "scene/latlong.h"
 
 namespace daylit::bake {
 namespace {
@@ -22,11 +23,37 @@ glm::mat3 FrameFor(const glm::vec3& normal, size_t index) {
   return BasisAround(normal) * spin;
 }
 
+// Radiance of model point y (hit by a ray, with `hit`'s surface and normal) at capture time.
+glm::vec3 RadianceAt(const CaptureScene& capture, const glm::vec3& y, const scene::RayHit& hit) {
+  const glm::vec3 toward = y - capture.capture_position;
+  const int texel = scene::LatLongTexel(glm::dvec3(toward), capture.env->width, capture.env->height);
+  const float* p = &capture.env->rgb[static_cast<size_t>(texel) * 3];
+  const glm::vec3 texel_radiance(p[0], p[1], p[2]);
+  if (capture.hidden == nullptr || capture.env_distance == nullptr) return texel_radiance;
+  // The capture point sees y unless its own ray toward y stops clearly short of it. The texel's
+  // ray can be up to a texel off y's direction; on y's own surface seen at a grazing angle that
+  // moves its hit along the surface by distance·angle / cos, so the slack grows with obliquity.
+  const float distance = glm::length(toward);
+  const float seen = (*capture.env_distance)[static_cast<size_t>(texel)];
+  const float texel_angle = 2.0f * glm::pi<float>() / static_cast<float>(capture.env->height);
+  const bool same_surface = (*capture.env_surface)[static_cast<size_t>(texel)] == hit.surface;
+  const float obliquity = std::max(0.05f, std::abs(glm::dot(hit.normal, toward / distance)));
+  const float slack = 0.05f + distance * texel_angle * (same_surface ? 2.0f / obliquity : 2.0f);
+  if (seen >= 0.0f && seen >= distance - slack) return texel_radiance;
+  const CaptureSun& sun = capture.sun;
+  glm::vec3 e = capture.hidden->indirect[hit.surface];
+  const float cos_sun = glm::dot(hit.normal, sun.dir);
+  if (sun.above_horizon && cos_sun > 0.0f && !capture.caster->Occluded(y + 2e-3f * hit.normal, sun.dir)) {
+    e += sun.dni_rgb * cos_sun;
+  }
+  return capture.hidden->albedo[hit.surface] * glm::one_over_pi<float>() * e;
+}
+
 }  // namespace
 
 void IntegrateCaptureIrradiance(const CaptureScene& capture, const RayOptions& options, const glm::vec3* points,
                                 const glm::vec3* normals, size_t count, float* sky_visibility, glm::vec3* irradiance,
-                                Progress* progress) {
+                                glm::vec3* direct, Progress* progress) {
   const std::vector<glm::vec3> hemisphere = CosineHemisphere(options.hemisphere_rays);
   const float inv_rays = 1.0f / static_cast<float>(hemisphere.size());
   const CaptureSun& sun = capture.sun;
@@ -43,14 +70,15 @@ void IntegrateCaptureIrradiance(const CaptureScene& capture, const RayOptions& o
           sum += Lookup(*capture.sky, dir);
           ++sky;
         } else {
-          sum += Lookup(*capture.env, origin + hit.t * dir - capture.capture_position);
+          sum += RadianceAt(capture, origin + hit.t * dir, hit);
         }
       }
-      glm::vec3 e = glm::pi<float>() * inv_rays * sum;
+      glm::vec3 sun_part(0.0f);
       const float cos_sun = glm::dot(normals[i], sun.dir);
-      if (sun.above_horizon && cos_sun > 0.0f && !capture.caster->Occluded(origin, sun.dir)) e += sun.dni_rgb * cos_sun;
+      if (sun.above_horizon && cos_sun > 0.0f && !capture.caster->Occluded(origin, sun.dir)) sun_part = sun.dni_rgb * cos_sun;
       sky_visibility[i] = static_cast<float>(sky) * inv_rays;
-      irradiance[i] = e;
+      irradiance[i] = glm::pi<float>() * inv_rays * sum + sun_part;
+      if (direct != nullptr) direct[i] = sun_part;
     }
     if (progress != nullptr) progress->Advance(range.size());
   });

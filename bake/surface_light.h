@@ -20,11 +20,22 @@ struct RayOptions {
   float offset_m = 2e-3f;     // ray origins are moved this far along the normal (self-hits)
 };
 
+// Radiance of model points the capture point cannot see (the env map shows what hides them):
+// L = ρ_s/π · (E_sun·s·max(0, n·l) + E_indirect,s) with the surface's albedo and typical indirect
+// irradiance from a first, coarser pass.
+struct HiddenSurfaceModel {
+  std::vector<glm::vec3> albedo;    // per surface
+  std::vector<glm::vec3> indirect;  // per surface: median E − E_sun over its visible texels
+};
+
 // What the scene looked like at capture time.
 struct CaptureScene {
   const scene::RayCaster* caster = nullptr;
   const scene::HdrImage* env = nullptr;  // captured radiance, sun disc removed
   const scene::HdrImage* sky = nullptr;  // SkyOnly(env): sky radiance in every direction
+  const std::vector<float>* env_distance = nullptr;    // per texel: capture point to its hit (< 0: sky)
+  const std::vector<uint32_t>* env_surface = nullptr;  // per texel: the surface it shows
+  const HiddenSurfaceModel* hidden = nullptr;         // null: hidden points take the texel's radiance
   glm::vec3 capture_position{0.0f};
   CaptureSun sun;
 };
@@ -32,10 +43,12 @@ struct CaptureScene {
 // For each point (unit normal facing its visible side): V = share of cosine-weighted rays that
 // reach the sky, and E = E_sun·s·max(0, n·l) + π·mean(L_in), where L_in is the sky's radiance
 // for rays that escape and, for rays that hit the model at y, y's radiance in the env map (the
-// texel toward y from the capture position: one bounce). Parallel over points.
+// texel toward y from the capture position: one bounce), or the HiddenSurfaceModel's where the
+// capture point does not see y. `direct` (optional) receives the E_sun·s·max(0, n·l) part.
+// Parallel over points.
 void IntegrateCaptureIrradiance(const CaptureScene& capture, const RayOptions& options, const glm::vec3* points,
                                 const glm::vec3* normals, size_t count, float* sky_visibility, glm::vec3* irradiance,
-                                Progress* progress);
+                                glm::vec3* direct, Progress* progress);
 
 // V alone, with occlusion rays (cheaper than IntegrateCaptureIrradiance).
 void SkyVisibility(const scene::RayCaster& caster, const RayOptions& options, const glm::vec3* points,

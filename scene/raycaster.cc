@@ -46,6 +46,9 @@ RayCaster::RayCaster(const SceneModel& model) : model_(model), embree_(std::make
   rtcSetDeviceErrorFunction(embree_->device, OnEmbreeError, nullptr);
   embree_->scene = rtcNewScene(embree_->device);
   rtcSetSceneBuildQuality(embree_->scene, RTC_BUILD_QUALITY_HIGH);
+  // Watertight: without it, rays through a shared edge (the diagonal of a quad) can miss both
+  // triangles, and a pixel of solid ground reads as sky.
+  rtcSetSceneFlags(embree_->scene, RTC_SCENE_FLAG_ROBUST);
 
   std::vector<uint32_t> kept;
   kept.reserve(model.triangles.size());

@@ -1,0 +1,188 @@
+#include "bake/bake.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "bake/synthetic_recording.h"
+#include "base/error.h"
+#include "scene/latlong.h"
+#include "scene/raycaster.h"
+
+namespace daylit::bake {
+namespace {
+
+using testing::SyntheticRecording;
+
+scene::SceneModel GroundAndLongWall() {
+  // Ground, and a wall 400 m long and 200 m tall standing at x = 1: practically infinite for V.
+  scene::SceneModel m;
+  m.surface_names = {"ground", "wall"};
+  m.vertices = {{-500, -500, 0}, {500, -500, 0}, {500, 500, 0}, {-500, 500, 0},
+                {1, -200, 0},    {1, 200, 0},    {1, 200, 200}, {1, -200, 200}};
+  m.triangles = {{{0, 1, 2}, 0}, {{0, 2, 3}, 0}, {{4, 6, 5}, 1}, {{4, 7, 6}, 1}};
+  return m;
+}
+
+TEST(BakeTest, SkyVisibilityMatchesAnalyticValues) {
+  const scene::SceneModel model = GroundAndLongWall();
+  const scene::RayCaster caster(model);
+  // Ground at the foot of the wall, and the wall's face 2 m up: the vertical plane cuts the
+  // cosine-weighted hemisphere in half, so 0.5 (the ground's edge 500 m away hides 0.2° of the
+  // wall's lower half). Open ground, far behind the wall's end: 1. The 0.01 bar is the issue's.
+  const std::vector<glm::vec3> points = {{0, 495, 0}, {0.999f, 0, 0}, {1, 0, 2}};
+  const std::vector<glm::vec3> normals = {{0, 0, 1}, {0, 0, 1}, {-1, 0, 0}};
+  std::vector<float> v(points.size());
+  SkyVisibility(caster, RayOptions{}, points.data(), normals.data(), points.size(), v.data(), nullptr);
+  EXPECT_NEAR(v[0], 1.0f, 0.01f);
+  EXPECT_NEAR(v[1], 0.5f, 0.01f);
+  EXPECT_NEAR(v[2], 0.5f, 0.01f);
+  // Many random points on the foot line: each within 0.01 (stratified rays, per-point rotation).
+  std::vector<glm::vec3> foot, up;
+  for (int i = 0; i < 200; ++i) foot.emplace_back(0.999f, -50.0f + 0.5f * static_cast<float>(i), 0.0f), up.emplace_back(0, 0, 1);
+  std::vector<float> vf(foot.size());
+  SkyVisibility(caster, RayOptions{}, foot.data(), up.data(), foot.size(), vf.data(), nullptr);
+  for (const float x : vf) ASSERT_NEAR(x, 0.5f, 0.01f);
+}
+
+TEST(BakeTest, SunVisibilityCastsTheWallsShadow) {
+  const scene::SceneModel model = GroundAndLongWall();
+  const scene::RayCaster caster(model);
+  const glm::vec3 sun = glm::normalize(glm::vec3(1.0f, 0.0f, 1.0f));  // 45° high, behind the wall
+  const std::vector<glm::vec3> points = {{-100, 0, 0}, {-300, 0, 0}, {2, 0, 0}, {0, 0, 0}};
+  const std::vector<glm::vec3> normals(points.size(), glm::vec3(0, 0, 1));
+  std::vector<uint8_t> lit(points.size());
+  SunVisibility(caster, points.data(), normals.data(), points.size(), sun, 2e-3f, lit.data());
+  // The 200 m wall shades 200 m of ground west of it; beyond and east of it is sunlit.
+  EXPECT_EQ(lit, (std::vector<uint8_t>{0, 1, 1, 0}));
+  const glm::vec3 down(0, 0, -1);
+  SunVisibility(caster, points.data(), &down, 1, sun, 2e-3f, lit.data());
+  EXPECT_EQ(lit[0], 0);  // facing away
+}
+
+TEST(BakeTest, SunDiscIsMeasuredAndRemoved) {
+  scene::HdrImage env{1024, 512, std::vector<float>(1024 * 512 * 3, 2.0f)};
+  const glm::dvec3 sun = glm::normalize(glm::dvec3(0.3, 0.5, 0.6));
+  double dni = 0.0;
+  for (int v = 0; v < env.height; ++v) {
+    for (int u = 0; u < env.width; ++u) {
+      if (glm::dot(scene::LatLongDirection(u, v, env.width, env.height), sun) < std::cos(glm::radians(0.6))) continue;
+      float* p = env.Pixel(u, v);
+      p[0] = 5002.0f, p[1] = 4002.0f, p[2] = 3002.0f;
+      dni += 5000.0 * scene::LatLongTexelSolidAngle(v, env.width, env.height);
+    }
+  }
+  const CaptureSun found = ExtractSun(&env, sun, std::nullopt, "test");
+  EXPECT_NEAR(found.dni_from_map_rgb.x, dni, dni * 1e-4);
+  EXPECT_NEAR(found.dni_rgb.z, dni * 0.6, dni * 1e-4);  // no given DNI: the map's own
+  EXPECT_LT(found.brightest_offset_deg, 0.6);
+  float peak = 0.0f;
+  for (const float x : env.rgb) peak = std::max(peak, x);
+  EXPECT_FLOAT_EQ(peak, 2.0f);  // the disc is gone, the sky behind it restored
+  const CaptureSun given = ExtractSun(&env, sun, glm::dvec3(80, 60, 40), "test");
+  EXPECT_FLOAT_EQ(given.dni_rgb.y, 60.0f);
+  const CaptureSun night = ExtractSun(&env, -sun, glm::dvec3(80, 60, 40), "test");
+  EXPECT_EQ(night.dni_rgb, glm::vec3(0.0f));
+}
+
+TEST(BakeTest, SkyFillFollowsZenithAngleAndSunAngle) {
+  // A sky that brightens toward the horizon (radiance 1 + 9·(1 − cos θ)), with the lower half of
+  // the azimuths hidden (is_sky = 0): the fill must restore the same law there.
+  scene::HdrImage env{360, 180, std::vector<float>(360 * 180 * 3, 0.0f)};
+  std::vector<uint8_t> is_sky(360 * 180, 0);
+  for (int v = 0; v < 90; ++v) {
+    for (int u = 0; u < 360; ++u) {
+      const glm::dvec3 d = scene::LatLongDirection(u, v, 360, 180);
+      float* p = env.Pixel(u, v);
+      const float l = static_cast<float>(1.0 + 9.0 * (1.0 - d.z));
+      if (u < 180) {
+        p[0] = p[1] = p[2] = l;
+        is_sky[static_cast<size_t>(v) * 360 + u] = 1;
+      }
+    }
+  }
+  const scene::HdrImage sky = SkyOnly(env, is_sky, glm::vec3(0, 0, 1));  // sun at the zenith: γ = θ
+  for (int v = 0; v < 90; v += 7) {
+    const float expected = static_cast<float>(1.0 + 9.0 * (1.0 - scene::LatLongDirection(270, v, 360, 180).z));
+    EXPECT_NEAR(sky.Pixel(270, v)[0], expected, 0.2f) << v;  // within a 1° bin's spread
+  }
+}
+
+TEST(BakeTest, UniformSkyGivesBackTheGroundAlbedo) {
+  SyntheticRecording rec("albedo");
+  const scene::Scene scene = scene::LoadScene(rec.Write());
+  const SceneBake bake = RunBake(scene, BakeOptions{});
+  ASSERT_EQ(bake.albedo_table[0].surface, "ground");
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(bake.albedo_table[0].albedo[c], 0.4f, 0.4f * 0.01f);
+  // Every camera pixel sees the ground, diffuse, V = 1, albedo 0.4 (the one frame is flat).
+  EXPECT_EQ(bake.camera.DiffuseCount(), 64u * 48u);
+  for (size_t i = 0; i < bake.camera.albedo.size(); i += 97) {
+    ASSERT_NEAR(bake.camera.sky_visibility[i], 1.0f, 0.01f);
+    ASSERT_NEAR(bake.camera.albedo[i].y, 0.4f, 0.4f * 0.02f);
+  }
+  // Gather tables: 8 probes × 256 directions; sky directions keep their texel, ground directions
+  // take the texel that shows their hit point from the capture position (parallax).
+  ASSERT_EQ(bake.gather.ProbeCount(), 8u);
+  const GatherTables& g = bake.gather;
+  const glm::vec3 capture(0.0f, 0.0f, 1.5f);
+  for (size_t d = 0; d < g.directions.size(); ++d) {
+    const glm::vec3 probe = g.ProbePosition(1, 1, 0);  // (1, 1, 0.5)
+    const size_t probe_index = (0 * 2 + 1) * 2 + 1;
+    const glm::vec3 dir = g.directions[d];
+    glm::dvec3 toward = glm::dvec3(dir);
+    if (dir.z < 0.0f) toward = glm::dvec3(probe + (-probe.z / dir.z) * dir - capture);
+    EXPECT_EQ(g.texel[probe_index * g.directions.size() + d],
+              static_cast<uint32_t>(scene::LatLongTexel(toward, bake.env.width, bake.env.height)));
+  }
+}
+
+std::string BakeErrorOf(SyntheticRecording& rec, int env_height = 0) {
+  try {
+    RunBake(scene::LoadScene(rec.Write(env_height)), BakeOptions{});
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(BakeTest, BadInputsAreNamed) {
+  {
+    SyntheticRecording rec("nan");
+    rec.env = [](const glm::dvec3& d) { return d.z > 0.99 ? glm::vec3(NAN) : glm::vec3(1.0f); };
+    EXPECT_NE(BakeErrorOf(rec).find("are NaN or infinite"), std::string::npos);
+  }
+  {
+    SyntheticRecording rec("negative");
+    rec.env = [](const glm::dvec3& d) { return d.z < -0.99 ? glm::vec3(-1.0f) : glm::vec3(1.0f); };
+    EXPECT_NE(BakeErrorOf(rec).find("are negative"), std::string::npos);
+  }
+  {
+    SyntheticRecording rec("ratio");
+    EXPECT_NE(BakeErrorOf(rec, 100).find("is not a 2:1 latitude-longitude map"), std::string::npos);
+  }
+  {
+    SyntheticRecording rec("inside");  // a closed box (outward faces) around the capture point
+    rec.obj += "o box\nv -1 -1 0.5\nv 1 -1 0.5\nv 1 1 0.5\nv -1 1 0.5\nv -1 -1 2.5\nv 1 -1 2.5\nv 1 1 2.5\nv -1 1 2.5\n"
+               "f 9 10 11 12\nf 9 12 8 5\nf 8 7 6 5\nf 5 6 10 9\nf 6 7 11 10\nf 7 8 12 11\n";
+    EXPECT_NE(BakeErrorOf(rec).find("envmap.position (0, 0, 1.5) is inside the model"), std::string::npos)
+        << BakeErrorOf(rec);
+  }
+  {
+    SyntheticRecording rec("nodiffuse");  // the only diffuse surface lies behind the camera
+    rec.obj += "o roof\nv -1 -1 9\nv 1 -1 9\nv 1 1 9\nf 1 2 3\n";
+    rec.obj.replace(rec.obj.find("f 1 2 3\n"), 8, "f 5 6 7\n");
+    rec.scene["diffuse_surfaces"] = {"roof"};
+    EXPECT_NE(BakeErrorOf(rec).find("the camera sees no diffuse surface (diffuse_surfaces: roof)"), std::string::npos)
+        << BakeErrorOf(rec);
+  }
+  {
+    SyntheticRecording rec("degenerate");  // a zero-area triangle is left out, with a warning
+    rec.obj += "o sliver\nv 0 0 3\nv 1 0 3\nv 2 0 3\nf 5 6 7\n";
+    const scene::Scene scene = scene::LoadScene(rec.Write());
+    EXPECT_EQ(scene::RayCaster(scene.model).degenerate_triangles(), 1u);
+    EXPECT_NO_THROW(RunBake(scene, BakeOptions{}));
+  }
+}
+
+}  // namespace
+}  // namespace daylit::bake

@@ -1,0 +1,143 @@
+#include "bake/texture_detail.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <glm/gtc/constants.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "base/log.h"
+#include "capture/frame_reader.h"
+#include "scene/hdr_image.h"
+
+namespace daylit::bake {
+namespace {
+
+// Box sizes the per-pixel footprint is rounded to.
+constexpr std::array<int, 11> kBoxSizes = {1, 3, 5, 7, 9, 11, 13, 15, 17, 21, 25};
+constexpr int kMinSamples = 3;  // usable frames needed for a pixel's median
+
+// Linear float BGR of a decoded frame: 8-bit through the camera response; EXR is linear already.
+// Saturated or nearly black codes are marked NaN: their ratio says nothing.
+cv::Mat Linearize(const cv::Mat& frame, const capture::CameraResponse& response) {
+  cv::Mat out(frame.size(), CV_32FC3);
+  if (frame.depth() == CV_32F) return frame;
+  const std::array<float, 256> lut = response.LinearLut8();
+  for (int y = 0; y < frame.rows; ++y) {
+    const cv::Vec3b* in = frame.ptr<cv::Vec3b>(y);
+    cv::Vec3f* o = out.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < frame.cols; ++x) {
+      for (int c = 0; c < 3; ++c) o[x][c] = in[x][c] >= 250 || in[x][c] <= 3 ? NAN : lut[in[x][c]];
+    }
+  }
+  return out;
+}
+
+std::vector<cv::Mat> ReadFrames(const scene::Scene& scene, const std::vector<int>& indices) {
+  if (scene.frames.kind == scene::FrameSourceKind::kVideo) return capture::ReadVideoFrames(scene.frames.video, indices);
+  std::vector<cv::Mat> frames;
+  for (const int i : indices) {
+    const std::filesystem::path path = scene.frames.ImagePath(i);
+    if (path.extension() == ".exr") {
+      scene::HdrImage image = scene::ReadHdrImage(path);
+      cv::Mat rgb(image.height, image.width, CV_32FC3, image.rgb.data());
+      cv::Mat bgr;
+      cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+      frames.push_back(bgr);
+    } else {
+      frames.push_back(cv::imread(path.string(), cv::IMREAD_COLOR));
+    }
+  }
+  return frames;
+}
+
+}  // namespace
+
+std::vector<glm::vec3> CameraTextureDetail(const scene::Scene& scene, const std::vector<glm::vec3>& points,
+                                           const std::vector<uint8_t>& has_point, int env_height,
+                                           const DetailOptions& options) {
+  const int w = scene.intrinsics.width, h = scene.intrinsics.height;
+  std::vector<glm::vec3> detail(static_cast<size_t>(w) * h, glm::vec3(1.0f));
+  if (!scene.frame_times || scene.frame_times->frames.empty() || options.frames <= 0) return detail;
+  const int count = static_cast<int>(scene.frame_times->frames.size());
+  std::vector<int> indices;
+  for (int k = 0; k < options.frames; ++k) {
+    const int i = static_cast<int>((k + 0.5) * count / options.frames);
+    if (indices.empty() || i > indices.back()) indices.push_back(std::min(i, count - 1));
+  }
+  const std::vector<cv::Mat> frames = ReadFrames(scene, indices);
+
+  // Which box each pixel uses: an env texel (π/H rad seen from the capture point) in camera pixels.
+  const glm::vec3 capture(scene.envmap->position);
+  const glm::vec3 center(scene.Camera().CenterInWorld());
+  const float texel_rad = glm::pi<float>() / static_cast<float>(env_height);
+  const float focal = static_cast<float>(0.5 * (scene.intrinsics.fx + scene.intrinsics.fy));
+  std::vector<int8_t> box(detail.size(), -1);
+  std::array<bool, kBoxSizes.size()> used{};
+  for (size_t i = 0; i < detail.size(); ++i) {
+    if (!has_point[i]) continue;
+    const float pixels = options.footprint_scale * glm::length(points[i] - capture) * texel_rad * focal /
+                         glm::length(points[i] - center);
+    size_t b = 0;
+    while (b + 1 < kBoxSizes.size() && static_cast<float>(kBoxSizes[b + 1]) <= pixels + 1.0f) ++b;
+    box[i] = static_cast<int8_t>(b);
+    used[b] = true;
+  }
+
+  std::vector<std::array<std::vector<float>, 3>> samples(detail.size());
+  size_t decoded = 0;
+  for (const cv::Mat& frame : frames) {
+    if (frame.empty() || frame.cols != w || frame.rows != h) continue;
+    ++decoded;
+    const cv::Mat linear = Linearize(frame, scene.response);
+    // NaN-aware box means: blur the values with NaN as 0 and divide by the blurred validity.
+    cv::Mat valid(linear.size(), CV_32FC3), values = linear.clone();
+    for (int y = 0; y < h; ++y) {
+      cv::Vec3f* v = values.ptr<cv::Vec3f>(y);
+      cv::Vec3f* m = valid.ptr<cv::Vec3f>(y);
+      for (int x = 0; x < w; ++x) {
+        for (int c = 0; c < 3; ++c) {
+          m[x][c] = std::isnan(v[x][c]) ? 0.0f : 1.0f;
+          if (std::isnan(v[x][c])) v[x][c] = 0.0f;
+        }
+      }
+    }
+    for (size_t b = 0; b < kBoxSizes.size(); ++b) {
+      if (!used[b]) continue;
+      cv::Mat sum, weight;
+      const cv::Size size(kBoxSizes[b], kBoxSizes[b]);
+      cv::blur(values, sum, size, cv::Point(-1, -1), cv::BORDER_REFLECT);
+      cv::blur(valid, weight, size, cv::Point(-1, -1), cv::BORDER_REFLECT);
+      for (int y = 0; y < h; ++y) {
+        const cv::Vec3f* l = linear.ptr<cv::Vec3f>(y);
+        const cv::Vec3f* s = sum.ptr<cv::Vec3f>(y);
+        const cv::Vec3f* wt = weight.ptr<cv::Vec3f>(y);
+        for (int x = 0; x < w; ++x) {
+          const size_t i = static_cast<size_t>(y) * w + x;
+          if (box[i] != static_cast<int8_t>(b)) continue;
+          for (int c = 0; c < 3; ++c) {
+            const float mean = wt[x][c] > 0.5f ? s[x][c] / wt[x][c] : 0.0f;
+            if (!std::isnan(l[x][c]) && mean > 1e-4f) samples[i][static_cast<size_t>(2 - c)].push_back(l[x][c] / mean);
+          }
+        }
+      }
+    }
+  }
+  if (decoded == 0) {
+    Log().warn("{}: no frame could be read: camera albedo keeps the env map's resolution", scene.file.string());
+    return detail;
+  }
+  for (size_t i = 0; i < detail.size(); ++i) {
+    for (size_t c = 0; c < 3; ++c) {
+      std::vector<float>& s = samples[i][c];
+      if (static_cast<int>(s.size()) < std::min(kMinSamples, static_cast<int>(decoded))) continue;
+      std::nth_element(s.begin(), s.begin() + static_cast<ptrdiff_t>(s.size() / 2), s.end());
+      detail[i][static_cast<int>(c)] = std::clamp(s[s.size() / 2], 0.2f, 5.0f);
+    }
+  }
+  return detail;
+}
+
+}  // namespace daylit::bake
