@@ -220,28 +220,30 @@ std::optional<SceneBake> LoadBake(const fs::path& dir, const std::string& hash) 
   bake.capture_sun.disc_texels = sun["disc_texels"].get<size_t>();
   bake.capture_sun.brightest_offset_deg = sun["brightest_offset_deg"].get<double>();
   {
-    const scene::ExrChannels ch = scene::ReadExrChannels(
-        dir / "env_maps.exr", {"point.X", "point.Y", "point.Z", "normal.X", "normal.Y", "normal.Z", "V.Y", "E.R", "E.G",
-                               "E.B", "albedo.R", "albedo.G", "albedo.B", "L.R", "L.G", "L.B"});
+    scene::ExrChannels ch = scene::ReadExrChannels(
+        dir / "env_maps.exr",
+        {"point.X", "point.Y", "point.Z", "normal.X", "normal.Y", "normal.Z", "V.Y", "E.R", "E.G", "E.B", "albedo.R",
+         "albedo.G", "albedo.B", "L.R", "L.G", "L.B"},
+        {"surface"});
     EnvMapMaps& e = bake.env;
     e.width = ch.width, e.height = ch.height;
     e.point = Gather3(ch, 0), e.normal = Gather3(ch, 3), e.sky_visibility = ch.planes[6];
     e.irradiance = Gather3(ch, 7), e.albedo = Gather3(ch, 10), e.radiance = Gather3(ch, 13);
-    int w = 0, h = 0;
-    e.surface = scene::ReadExrUintChannel(dir / "env_maps.exr", "surface", &w, &h);
+    e.surface = std::move(ch.uints[0]);
   }
   {
-    const scene::ExrChannels ch = scene::ReadExrChannels(
-        dir / "camera_gbuffer.exr", {"point.X", "point.Y", "point.Z", "normal.X", "normal.Y", "normal.Z", "V.Y",
-                                     "albedo.R", "albedo.G", "albedo.B", "diffuse.Y"});
+    scene::ExrChannels ch = scene::ReadExrChannels(
+        dir / "camera_gbuffer.exr",
+        {"point.X", "point.Y", "point.Z", "normal.X", "normal.Y", "normal.Z", "V.Y", "albedo.R", "albedo.G",
+         "albedo.B", "diffuse.Y"},
+        {"surface", "env_texel"});
     CameraGBuffer& g = bake.camera;
     g.width = ch.width, g.height = ch.height;
     g.point = Gather3(ch, 0), g.normal = Gather3(ch, 3), g.sky_visibility = ch.planes[6], g.albedo = Gather3(ch, 7);
     g.diffuse.resize(ch.planes[10].size());
     for (size_t i = 0; i < g.diffuse.size(); ++i) g.diffuse[i] = ch.planes[10][i] > 0.5f ? 1 : 0;
-    int w = 0, h = 0;
-    g.surface = scene::ReadExrUintChannel(dir / "camera_gbuffer.exr", "surface", &w, &h);
-    g.env_texel = scene::ReadExrUintChannel(dir / "camera_gbuffer.exr", "env_texel", &w, &h);
+    g.surface = std::move(ch.uints[0]);
+    g.env_texel = std::move(ch.uints[1]);
   }
   const auto& gather = j["gather"];
   bake.gather.min = Vec(gather["min"]);
@@ -250,8 +252,7 @@ std::optional<SceneBake> LoadBake(const fs::path& dir, const std::string& hash) 
   const int directions = gather["directions"].get<int>();
   if (directions > 0) {
     bake.gather.directions = SphericalFibonacci(directions);
-    int w = 0, h = 0;
-    bake.gather.texel = scene::ReadExrUintChannel(dir / "gather.exr", "texel", &w, &h);
+    bake.gather.texel = std::move(scene::ReadExrChannels(dir / "gather.exr", {}, {"texel"}).uints[0]);
   }
   const CsvTable albedo = ReadCsvFile(dir / "albedo.csv");
   for (size_t r = 0; r < albedo.rows.size(); ++r) {

@@ -26,25 +26,34 @@ Imf::PixelType ToImf(ExrPixelType type) {
   return Imf::FLOAT;
 }
 
-// Reads `names` into float planes with OpenEXR's own conversion (missing channels: error).
-ExrChannels ReadPlanes(const std::filesystem::path& path, const std::vector<std::string>& names) {
+// Reads `names` as floats and `uint_names` as UINT in one pass (missing channels: error).
+ExrChannels ReadPlanes(const std::filesystem::path& path, const std::vector<std::string>& names,
+                       const std::vector<std::string>& uint_names) {
   ExrChannels out;
   Imf::InputFile file(path.c_str());
   const Imath::Box2i window = file.header().dataWindow();
   out.width = window.max.x - window.min.x + 1;
   out.height = window.max.y - window.min.y + 1;
   const size_t count = static_cast<size_t>(out.width) * out.height;
+  // Slices are addressed in data-window coordinates, so offset each base by the window's origin.
+  const ptrdiff_t origin = static_cast<ptrdiff_t>(window.min.y) * out.width + window.min.x;
+  const auto require = [&](const std::string& name) {
+    if (file.header().channels().findChannel(name) == nullptr) ThrowInputError("{}: no channel '{}'", path.string(), name);
+  };
   Imf::FrameBuffer frame;
   out.planes.resize(names.size());
   for (size_t i = 0; i < names.size(); ++i) {
-    if (file.header().channels().findChannel(names[i]) == nullptr) {
-      ThrowInputError("{}: no channel '{}'", path.string(), names[i]);
-    }
+    require(names[i]);
     out.planes[i].resize(count);
-    // Offset the base so that data window coordinates index the plane from 0.
-    char* base = reinterpret_cast<char*>(out.planes[i].data()) -
-                 (static_cast<ptrdiff_t>(window.min.y) * out.width + window.min.x) * static_cast<ptrdiff_t>(sizeof(float));
+    char* base = reinterpret_cast<char*>(out.planes[i].data() - origin);
     frame.insert(names[i], Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * static_cast<size_t>(out.width)));
+  }
+  out.uints.resize(uint_names.size());
+  for (size_t i = 0; i < uint_names.size(); ++i) {
+    require(uint_names[i]);
+    out.uints[i].resize(count);
+    char* base = reinterpret_cast<char*>(out.uints[i].data() - origin);
+    frame.insert(uint_names[i], Imf::Slice(Imf::UINT, base, sizeof(uint32_t), sizeof(uint32_t) * static_cast<size_t>(out.width)));
   }
   file.setFrameBuffer(frame);
   file.readPixels(window.min.y, window.max.y);
@@ -64,7 +73,7 @@ HdrImage ReadExrRgb(const std::filesystem::path& path) {
       ThrowInputError("{}: no R, G, B or Y channels", path.string());
     }
   }
-  const ExrChannels planes = ReadPlanes(path, names);
+  const ExrChannels planes = ReadPlanes(path, names, {});
   HdrImage image{planes.width, planes.height, {}};
   image.rgb.resize(static_cast<size_t>(image.width) * image.height * 3);
   for (size_t i = 0; i < static_cast<size_t>(image.width) * image.height; ++i) {
@@ -156,35 +165,10 @@ void WriteExr(const std::filesystem::path& path, int width, int height, const st
   CommitTemporary(tmp, path);
 }
 
-ExrChannels ReadExrChannels(const std::filesystem::path& path, const std::vector<std::string>& names) {
+ExrChannels ReadExrChannels(const std::filesystem::path& path, const std::vector<std::string>& names,
+                            const std::vector<std::string>& uint_names) {
   try {
-    return ReadPlanes(path, names);
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception& e) {
-    ThrowInputError("{}: not a readable OpenEXR file ({})", path.string(), e.what());
-  }
-}
-
-std::vector<uint32_t> ReadExrUintChannel(const std::filesystem::path& path, const std::string& name, int* width,
-                                         int* height) {
-  try {
-    Imf::InputFile file(path.c_str());
-    const Imath::Box2i window = file.header().dataWindow();
-    *width = window.max.x - window.min.x + 1;
-    *height = window.max.y - window.min.y + 1;
-    const Imf::Channel* channel = file.header().channels().findChannel(name);
-    if (channel == nullptr || channel->type != Imf::UINT) {
-      ThrowInputError("{}: no UINT channel '{}'", path.string(), name);
-    }
-    std::vector<uint32_t> data(static_cast<size_t>(*width) * *height);
-    char* base = reinterpret_cast<char*>(data.data()) -
-                 (static_cast<ptrdiff_t>(window.min.y) * *width + window.min.x) * static_cast<ptrdiff_t>(sizeof(uint32_t));
-    Imf::FrameBuffer frame;
-    frame.insert(name, Imf::Slice(Imf::UINT, base, sizeof(uint32_t), sizeof(uint32_t) * static_cast<size_t>(*width)));
-    file.setFrameBuffer(frame);
-    file.readPixels(window.min.y, window.max.y);
-    return data;
+    return ReadPlanes(path, names, uint_names);
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {

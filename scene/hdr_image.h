@@ -42,17 +42,15 @@ struct ExrChannel {
 // Writes a multi-channel OpenEXR (ZIP compressed) to a temporary file and renames it to `path`.
 void WriteExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels);
 
-// Reads named channels as floats (UINT channels are converted exactly up to 2^24). Throws
-// InputError naming the file and the missing channel.
+// Named channels of an OpenEXR file, read in one pass: float ones (HALF and FLOAT converted by
+// OpenEXR) and UINT ones exactly. Throws InputError naming the file and a missing channel.
 struct ExrChannels {
   int width = 0;
   int height = 0;
-  std::vector<std::vector<float>> planes;  // in the order asked
+  std::vector<std::vector<float>> planes;      // in the order asked
+  std::vector<std::vector<uint32_t>> uints;    // in the order asked
 };
-ExrChannels ReadExrChannels(const std::filesystem::path& path, const std::vector<std::string>& names);
-
-// Reads one UINT channel exactly.
-std::vector<uint32_t> ReadExrUintChannel(const std::filesystem::path& path, const std::string& name,
-                                         int* width, int* height);
+ExrChannels ReadExrChannels(const std::filesystem::path& path, const std::vector<std::string>& names,
+                            const std::vector<std::string>& uint_names = {});
 
 }  // namespace daylit::scene

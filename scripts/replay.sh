@@ -4,6 +4,8 @@
 #   info.txt  what `daylit info` says of the recording (validation, frames, sun path, surfaces)
 #   sun.csv   the sun for every frame (topocentric zenith/azimuth and the scene vector)
 #   sun.png   the sun's elevation and azimuth over the recording
+#   bake/     the offline scene maps (env-map and camera albedo, sky visibility, gather tables,
+#             albedo.csv, PNG previews); re-used while the recording is unchanged
 # Later parts of the pipeline (bake, estimation, relighting, rendering) join this job as they land.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -16,4 +18,7 @@ mkdir -p "$out"
 "$daylit" info "$recording" | tee "$out/info.txt.tmp"
 mv "$out/info.txt.tmp" "$out/info.txt"
 "$daylit" sunpos --scene "$recording" --frames --out "$out/sun.csv" --plot "$out/sun.png"
+"$daylit" bake "$recording" --cache "$out/bake" >/dev/null
+echo "albedo per surface (from the env map):"
+cat "$out/bake/albedo.csv"
 echo "results in $out/"
