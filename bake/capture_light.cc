@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <glm/gtc/constants.hpp>
+#include <glm/gtx/component_wise.hpp>
 
 #include "base/log.h"
 #include "scene/latlong.h"
@@ -95,34 +96,43 @@ scene::HdrImage SkyOnly(const scene::HdrImage& env, const std::vector<uint8_t>& 
       weight[b] += solid_angle;
     }
   }
-  // Means, then fill empty bins: along γ within a θ row, then rows from their nearest filled row.
-  std::vector<glm::vec3> mean(sum.size(), glm::vec3(0.0f));
-  std::vector<uint8_t> filled(sum.size(), 0), row_filled(kThetaBins, 0);
+  // Empty bins (directions the capture point never sees as sky, such as the low sky behind the
+  // buildings) get a harmonic fill in log radiance: each is the mean of its four neighbours,
+  // iterated to convergence, so holes blend between the known sky on every side. Copying the
+  // nearest filled bin instead carried the bright aureole 40° away into the dim sky at 90° from
+  // the sun and made shaded walls too warm.
+  std::vector<glm::vec3> log_mean(sum.size(), glm::vec3(0.0f));
+  std::vector<uint8_t> known(sum.size(), 0);
+  bool any = false;
   for (size_t b = 0; b < sum.size(); ++b) {
-    if (weight[b] > 0.0) mean[b] = glm::vec3(sum[b] / weight[b]), filled[b] = 1, row_filled[b / kGammaBins] = 1;
+    if (weight[b] <= 0.0) continue;
+    log_mean[b] = glm::log(glm::max(glm::vec3(sum[b] / weight[b]), glm::vec3(1e-6f)));
+    known[b] = 1;
+    any = true;
   }
-  for (int t = 0; t < kThetaBins; ++t) {
-    if (!row_filled[static_cast<size_t>(t)]) continue;
-    const size_t row = static_cast<size_t>(t) * kGammaBins;
-    for (int g = 0; g < kGammaBins; ++g) {
-      if (filled[row + static_cast<size_t>(g)]) continue;
-      for (int step = 1; step < kGammaBins; ++step) {
-        if (g - step >= 0 && filled[row + static_cast<size_t>(g - step)]) { mean[row + static_cast<size_t>(g)] = mean[row + static_cast<size_t>(g - step)]; break; }
-        if (g + step < kGammaBins && filled[row + static_cast<size_t>(g + step)]) { mean[row + static_cast<size_t>(g)] = mean[row + static_cast<size_t>(g + step)]; break; }
+  if (!any) return env;  // no sky at all: nothing to fill from
+  glm::vec3 known_mean(0.0f);
+  float known_count = 0.0f;
+  for (size_t b = 0; b < sum.size(); ++b) known_mean += known[b] ? log_mean[b] : glm::vec3(0.0f), known_count += known[b];
+  for (size_t b = 0; b < sum.size(); ++b) {
+    if (!known[b]) log_mean[b] = known_mean / known_count;
+  }
+  const auto at = [&](int t, int g) { return log_mean[static_cast<size_t>(std::clamp(t, 0, kThetaBins - 1)) * kGammaBins + static_cast<size_t>(std::clamp(g, 0, kGammaBins - 1))]; };
+  for (int iteration = 0; iteration < 2000; ++iteration) {
+    float change = 0.0f;
+    for (int t = 0; t < kThetaBins; ++t) {
+      for (int g = 0; g < kGammaBins; ++g) {
+        const size_t b = static_cast<size_t>(t) * kGammaBins + static_cast<size_t>(g);
+        if (known[b]) continue;
+        const glm::vec3 next = 0.25f * (at(t - 1, g) + at(t + 1, g) + at(t, g - 1) + at(t, g + 1));
+        change = std::max(change, glm::compMax(glm::abs(next - log_mean[b])));
+        log_mean[b] = next;
       }
     }
+    if (change < 1e-4f) break;
   }
-  for (int t = 0; t < kThetaBins; ++t) {
-    if (row_filled[static_cast<size_t>(t)]) continue;
-    for (int step = 1; step < kThetaBins; ++step) {
-      const int from = t - step >= 0 && row_filled[static_cast<size_t>(t - step)] ? t - step
-                       : t + step < kThetaBins && row_filled[static_cast<size_t>(t + step)] ? t + step : -1;
-      if (from < 0) continue;
-      std::copy_n(mean.begin() + static_cast<ptrdiff_t>(from) * kGammaBins, kGammaBins,
-                  mean.begin() + static_cast<ptrdiff_t>(t) * kGammaBins);
-      break;
-    }
-  }
+  std::vector<glm::vec3> mean(sum.size());
+  for (size_t b = 0; b < sum.size(); ++b) mean[b] = known[b] ? glm::vec3(sum[b] / weight[b]) : glm::exp(log_mean[b]);
   scene::HdrImage sky = env;
   for (int v = 0; v < env.height; ++v) {
     for (int u = 0; u < env.width; ++u) {

@@ -39,8 +39,8 @@ CaptureSun ExtractSun(scene::HdrImage* env, const glm::dvec3& sun_dir, const std
 // it sees the model instead, the mean of the visible sky at the same zenith angle θ and the same
 // angle γ from the sun (1° × 2° bins). A clear sky is, to first order, a function of (θ, γ)
 // alone, and the two carry what matters to a wall: the bright sky near the horizon (up to ten
-// times the zenith's) and the aureole around the sun. Empty bins take the nearest filled bin at
-// the same θ, else the nearest filled θ.
+// times the zenith's) and the aureole around the sun. Empty bins are filled harmonically (in log
+// radiance) from the known bins around them.
 scene::HdrImage SkyOnly(const scene::HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir);
 
 // Nearest-texel radiance of a lat-long map in direction `dir`.

@@ -1,9 +1,5 @@
 // The bake of the bundled recording against its ground truth: per-surface albedo within 5% and
 // per-pixel albedo median relative error ≤ 10% (the issue's figures), and the cache round trip.
-//
-// Known gap (issue 3 stays open on it): the two walls in shadow at capture time, lit almost only
-// by light reflected from sunlit surfaces, read 5-6% low in red (building_south, wall_east); see
-// docs/bake.md. They are held at 7% here so that any further drift still fails.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -54,8 +50,7 @@ TEST(BakeRecordingTest, AlbedoMatchesGroundTruthAndTheCacheReloads) {
       const double ours = Median(values);
       std::printf("%-16s %c truth %.4f ours %.4f (%+.1f%%)\n", name.c_str(), "RGB"[c], expected, ours,
                   100.0 * (ours / expected - 1.0));
-      const bool known_gap = c == 0 && (name == "building_south" || name == "wall_east");
-      EXPECT_NEAR(ours / expected, 1.0, known_gap ? 0.07 : 0.05) << name << " channel " << c;
+      EXPECT_NEAR(ours / expected, 1.0, 0.05) << name << " channel " << c;
     }
   }
   // Per pixel, where the truth has albedo and we see a surface.
