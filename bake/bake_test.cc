@@ -136,6 +136,32 @@ TEST(BakeTest, UniformSkyGivesBackTheGroundAlbedo) {
   }
 }
 
+TEST(BakeTest, DiffuseMaskOverTheEnvMapSelectsPixels) {
+  // A mask that allows only the env-map texels west of the capture point (x < 0): exactly the
+  // camera pixels that see ground with x < 0 become diffuse.
+  SyntheticRecording rec("mask");
+  cv::Mat mask(rec.env_width / 2, rec.env_width, CV_8UC1, cv::Scalar(0));
+  for (int v = 0; v < mask.rows; ++v) {
+    for (int u = 0; u < mask.cols; ++u) {
+      if (scene::LatLongDirection(u, v, mask.cols, mask.rows).x < 0.0) mask.at<uint8_t>(v, u) = 255;
+    }
+  }
+  rec.Write();
+  cv::imwrite((rec.dir / "mask.png").string(), mask);
+  rec.scene.erase("diffuse_surfaces");
+  rec.scene["diffuse_mask"] = "mask.png";
+  const SceneBake bake = RunBake(scene::LoadScene(rec.Write()), BakeOptions{});
+  size_t mismatches = 0, diffuse = 0;
+  for (size_t i = 0; i < bake.camera.diffuse.size(); ++i) {
+    const float x = bake.camera.point[i].x;
+    if (std::abs(x) < 0.05f) continue;  // the texel column on the boundary
+    mismatches += (bake.camera.diffuse[i] != 0) != (x < 0.0f);
+    diffuse += bake.camera.diffuse[i];
+  }
+  EXPECT_EQ(mismatches, 0u);
+  EXPECT_NEAR(static_cast<double>(diffuse), 64.0 * 48.0 / 2.0, 64.0 * 2.0);
+}
+
 std::string BakeErrorOf(SyntheticRecording& rec, int env_height = 0) {
   try {
     RunBake(scene::LoadScene(rec.Write(env_height)), BakeOptions{});

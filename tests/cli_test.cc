@@ -11,6 +11,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "bake/synthetic_recording.h"
 #include "base/atomic_file.h"
 #include "base/csv.h"
 #include "scene/scene_test_util.h"
@@ -113,6 +114,31 @@ TEST(CliTest, SunposCsvBatchMatchesThePublishedSpaExample) {
   EXPECT_FALSE(fs::exists(dir / "bad_out.csv"));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 3);  // no temporaries
   fs::remove_all(dir);
+}
+
+TEST(CliTest, BakePrintsAlbedoUsesItsCacheAndRebakesOnChange) {
+  bake::testing::SyntheticRecording rec("cli_bake");
+  const std::string scene = rec.Write().string();
+  const std::string cache = (rec.dir / "cache").string();
+  const CliRun first = Daylit("bake " + scene + " --cache " + cache + " --print-albedo");
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  const CsvTable table = ParseCsv(first.out, "stdout");
+  EXPECT_EQ(table.header, (std::vector<std::string>{"surface", "r", "g", "b", "pixels"}));
+  ASSERT_EQ(table.rows.size(), 1u);
+  EXPECT_NEAR(ParseFiniteDouble(table.rows[0][1], "r"), 0.4, 0.004);
+  EXPECT_NE(first.err.find("baked"), std::string::npos) << first.err;
+  EXPECT_EQ(ReadTextFile(fs::path(cache) / "albedo.csv"), first.out);
+  // Unchanged: loaded from the cache, and the cache folder is what it prints without flags.
+  const CliRun second = Daylit("bake " + scene + " --cache " + cache);
+  EXPECT_NE(second.err.find("loaded the cached bake"), std::string::npos) << second.err;
+  EXPECT_EQ(second.out, cache + "\n");
+  // A changed env map is a new bake.
+  rec.env = [](const glm::dvec3& d) { return d.z > 0.0 ? glm::vec3(2.0f) : glm::vec3(0.6f); };
+  rec.Write();
+  const CliRun third = Daylit("bake " + scene + " --cache " + cache + " --print-albedo");
+  EXPECT_NE(third.err.find("baked"), std::string::npos) << third.err;
+  EXPECT_EQ(third.err.find("loaded"), std::string::npos) << third.err;
+  EXPECT_NEAR(ParseFiniteDouble(ParseCsv(third.out, "stdout").rows[0][1], "r"), 0.3, 0.003);  // 0.6 / 2
 }
 
 struct BadCall {
