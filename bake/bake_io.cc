@@ -201,6 +201,13 @@ void SaveBake(const SceneBake& bake, const scene::Scene& scene, const BakeOption
   WriteFileAtomically(dir / "bake.json", j.dump(1) + "\n");
 }
 
+namespace {
+
+// Reads a cache whose bake.json matches; throws InputError if one of its files is damaged.
+SceneBake ReadBake(const fs::path& dir, const std::string& hash, const nlohmann::json& j);
+
+}  // namespace
+
 std::optional<SceneBake> LoadBake(const fs::path& dir, const std::string& hash) {
   if (!fs::is_regular_file(dir / "bake.json")) return std::nullopt;
   nlohmann::json j;
@@ -210,6 +217,17 @@ std::optional<SceneBake> LoadBake(const fs::path& dir, const std::string& hash) 
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;
   }
+  try {
+    return ReadBake(dir, hash, j);
+  } catch (const std::exception& e) {  // a damaged cache is re-baked, not an error
+    Log().warn("{}: the cached bake cannot be read ({}); baking again", dir.string(), e.what());
+    return std::nullopt;
+  }
+}
+
+namespace {
+
+SceneBake ReadBake(const fs::path& dir, const std::string& hash, const nlohmann::json& j) {
   SceneBake bake;
   bake.hash = hash;
   const auto& sun = j["capture_sun"];
@@ -264,6 +282,8 @@ std::optional<SceneBake> LoadBake(const fs::path& dir, const std::string& hash) 
   }
   return bake;
 }
+
+}  // namespace
 
 SceneBake BakeOrLoad(const scene::Scene& scene, const BakeOptions& options, const fs::path& dir, bool* loaded) {
   const std::string hash = BakeHash(scene, options);

@@ -132,6 +132,12 @@ TEST(CliTest, BakePrintsAlbedoUsesItsCacheAndRebakesOnChange) {
   const CliRun second = Daylit("bake " + scene + " --cache " + cache);
   EXPECT_NE(second.err.find("loaded the cached bake"), std::string::npos) << second.err;
   EXPECT_EQ(second.out, cache + "\n");
+  // A damaged cache file is baked again, with a warning, not an error.
+  WriteFileAtomically(fs::path(cache) / "camera_gbuffer.exr", "not an EXR");
+  const CliRun damaged = Daylit("bake " + scene + " --cache " + cache);
+  EXPECT_EQ(damaged.exit_code, 0) << damaged.err;
+  EXPECT_NE(damaged.err.find("cannot be read"), std::string::npos) << damaged.err;
+  EXPECT_NE(damaged.err.find("baked"), std::string::npos) << damaged.err;
   // A changed env map is a new bake.
   rec.env = [](const glm::dvec3& d) { return d.z > 0.0 ? glm::vec3(2.0f) : glm::vec3(0.6f); };
   rec.Write();
