@@ -1,0 +1,64 @@
+// The per-frame fit of seed 001, per colour channel: observed radiance at sampled points of the
+// diffuse surfaces against the model of design.md,
+//
+//   y_i = ρ_i/π · (a_i · E_sun + b_i · E_sky),   a_i = s_i·max(0, n_i·l),  b_i = V_i,
+//
+// for E_sun, E_sky ≥ 0. Robust: a median-based start from the shadowed and the sunlit samples,
+// then iteratively reweighted least squares with a Cauchy loss on relative residuals (albedo and
+// registration errors are multiplicative), so that a person walking through the view or a
+// misregistered shadow edge does not move the estimate.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "estimation/lighting_model.h"
+
+namespace daylit::estimation {
+
+// One sampled pixel: what the model needs and what the camera saw (radiance units: the
+// linearised pixel divided by the exposure).
+struct Sample {
+  glm::vec3 radiance{0.0f};
+  glm::vec3 albedo{0.0f};
+  float sun = 0.0f;  // a = s·max(0, n·l)
+  float sky = 0.0f;  // b = V
+};
+
+struct SunSkyFitOptions {
+  double cauchy_scale = 0.1;        // relative residual at which a sample's weight halves
+  int iterations = 12;              // IRLS iterations
+  double sunlit_threshold = 0.05;   // a above this: a sunlit sample
+  int min_stratum_samples = 30;     // per stratum (sunlit, shadowed) for full confidence
+  double confident_residual = 0.08; // robust relative residual spread at which confidence is 1/e
+
+  bool Check(std::string* why) const;
+};
+
+enum class SunSkyFitStatus {
+  kConverged,
+  kSkyOnly,         // no sunlit samples (sun below the horizon or every sample shadowed): E_sun = 0
+  kTooFewSamples,   // fewer than 10 usable samples: nothing fitted
+};
+
+struct SunSkyFitSummary {
+  SunSkyFitStatus status = SunSkyFitStatus::kTooFewSamples;
+  SunSky light;                 // E_sun (DNI) and E_sky (DHI), RGB, ≥ 0
+  double confidence = 0.0;      // in [0, 1]
+  double residual_spread = 0.0; // 1.4826·median |relative residual| over channels (robust σ)
+  int sunlit_samples = 0;
+  int shadowed_samples = 0;
+  double inlier_share = 0.0;    // samples with |relative residual| < 3·cauchy_scale
+  std::string message;
+
+  bool IsUsable() const { return status != SunSkyFitStatus::kTooFewSamples; }
+};
+
+// Fits E_sun and E_sky to `samples`. Never throws; a frame that cannot be fitted returns a
+// summary with status kTooFewSamples and a message.
+SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sample>& samples);
+
+}  // namespace daylit::estimation

@@ -1,0 +1,105 @@
+#include "estimation/sun_sky_fit.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include <glm/gtc/constants.hpp>
+
+namespace daylit::estimation {
+namespace {
+
+// courtyard-a's clear morning: E_sun (DNI) and E_sky (DHI), radiance units.
+const SunSky kClear{{86.26, 63.58, 37.08}, {9.86, 9.68, 9.96}};
+
+// Samples as the sampler draws them: 40% in shadow, the rest sunlit at various angles; albedo and
+// sky visibility as on textured walls and ground. Radiance exactly the model's.
+std::vector<Sample> MakeSamples(const SunSky& light, int count, std::mt19937& rng) {
+  std::uniform_real_distribution<float> albedo(0.1f, 0.7f), cosine(0.1f, 1.0f), v(0.2f, 1.0f), pick(0, 1);
+  std::vector<Sample> samples(static_cast<size_t>(count));
+  for (Sample& s : samples) {
+    s.albedo = {albedo(rng), albedo(rng), albedo(rng)};
+    s.sun = pick(rng) < 0.4f ? 0.0f : cosine(rng);
+    s.sky = v(rng);
+    s.radiance = glm::vec3(Radiance(glm::dvec3(s.albedo), ShadingTerms{s.sun, s.sky}, light));
+  }
+  return samples;
+}
+
+void ExpectNear(const SunSky& got, const SunSky& want, double relative) {
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(got.sun_rgb[c], want.sun_rgb[c], relative * want.sun_rgb[c]) << "sun channel " << c;
+    EXPECT_NEAR(got.sky_rgb[c], want.sky_rgb[c], relative * want.sky_rgb[c]) << "sky channel " << c;
+  }
+}
+
+TEST(SunSkyFitTest, ExactSamplesAreRecoveredTo0_1Percent) {
+  std::mt19937 rng(1);
+  const SunSkyFitSummary fit = FitSunSky({}, MakeSamples(kClear, 5000, rng));
+  ASSERT_EQ(fit.status, SunSkyFitStatus::kConverged) << fit.message;
+  ExpectNear(fit.light, kClear, 1e-3);
+  EXPECT_GT(fit.confidence, 0.99);
+}
+
+TEST(SunSkyFitTest, SensorNoiseWithin1Percent) {
+  std::mt19937 rng(2);
+  std::vector<Sample> samples = MakeSamples(kClear, 5000, rng);
+  std::normal_distribution<float> noise(0.0f, 0.03f);  // 3% per pixel
+  for (Sample& s : samples) s.radiance *= glm::vec3(1.0f + noise(rng), 1.0f + noise(rng), 1.0f + noise(rng));
+  const SunSkyFitSummary fit = FitSunSky({}, samples);
+  ExpectNear(fit.light, kClear, 0.01);
+  EXPECT_GT(fit.confidence, 0.7);
+  EXPECT_NEAR(fit.residual_spread, 0.03, 0.01);
+}
+
+TEST(SunSkyFitTest, OutliersAndAMovingOccluderDoNotMoveTheEstimate) {
+  std::mt19937 rng(3);
+  std::vector<Sample> samples = MakeSamples(kClear, 5000, rng);
+  std::uniform_real_distribution<float> wild(0.0f, 40.0f);
+  // 10% wild values (specular glints, misregistration), and a person in dark clothes covering
+  // 15% of the samples (a contiguous block: one region of the image).
+  for (size_t i = 0; i < samples.size(); i += 10) samples[i].radiance = {wild(rng), wild(rng), wild(rng)};
+  for (size_t i = 1000; i < 1750; ++i) samples[i].radiance *= 0.25f;
+  const SunSkyFitSummary fit = FitSunSky({}, samples);
+  ExpectNear(fit.light, kClear, 0.02);
+  EXPECT_LT(fit.inlier_share, 0.8);  // the outliers are seen as such
+}
+
+TEST(SunSkyFitTest, OvercastGivesNoSunWithConfidence) {
+  // Sunlit and shadowed areas look alike: E_sun must come out ≈ 0, not noise.
+  std::mt19937 rng(4);
+  const SunSky overcast{{0.0, 0.0, 0.0}, {30.7, 30.7, 30.7}};
+  std::vector<Sample> samples = MakeSamples(overcast, 5000, rng);
+  std::normal_distribution<float> noise(0.0f, 0.02f);
+  for (Sample& s : samples) s.radiance *= 1.0f + noise(rng);
+  const SunSkyFitSummary fit = FitSunSky({}, samples);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_LT(fit.light.sun_rgb[c], 0.01 * overcast.sky_rgb[c]) << c;
+    EXPECT_NEAR(fit.light.sky_rgb[c], 30.7, 0.3);
+  }
+  EXPECT_GT(fit.confidence, 0.8);
+}
+
+TEST(SunSkyFitTest, SunBelowTheHorizonFitsTheSkyAlone) {
+  std::mt19937 rng(5);
+  std::vector<Sample> samples = MakeSamples({{0, 0, 0}, {1.2, 1.5, 2.1}}, 2000, rng);
+  for (Sample& s : samples) s.sun = 0.0f;
+  const SunSkyFitSummary fit = FitSunSky({}, samples);
+  EXPECT_EQ(fit.status, SunSkyFitStatus::kSkyOnly);
+  EXPECT_EQ(fit.light.sun_rgb, glm::dvec3(0.0));
+  EXPECT_NEAR(fit.light.sky_rgb.z, 2.1, 2.1e-3);
+}
+
+TEST(SunSkyFitTest, TooFewSamplesIsAStatusNotACrash) {
+  std::mt19937 rng(6);
+  const SunSkyFitSummary fit = FitSunSky({}, MakeSamples(kClear, 5, rng));
+  EXPECT_EQ(fit.status, SunSkyFitStatus::kTooFewSamples);
+  EXPECT_FALSE(fit.IsUsable());
+  EXPECT_EQ(fit.message, "5 usable samples (need 10)");
+  std::string why;
+  EXPECT_FALSE((SunSkyFitOptions{-1.0}.Check(&why)));
+  EXPECT_TRUE(SunSkyFitOptions{}.Check(&why));
+}
+
+}  // namespace
+}  // namespace daylit::estimation
