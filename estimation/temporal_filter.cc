@@ -1,0 +1,55 @@
+#include "estimation/temporal_filter.h"
+
+#include <algorithm>
+#include <vector>
+
+namespace daylit::estimation {
+namespace {
+
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + static_cast<ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+SunSky WindowMedian(const std::deque<SunSky>& window) {
+  SunSky out;
+  std::vector<double> sun(window.size()), sky(window.size());
+  for (int c = 0; c < 3; ++c) {
+    for (size_t i = 0; i < window.size(); ++i) sun[i] = window[i].sun_rgb[c], sky[i] = window[i].sky_rgb[c];
+    out.sun_rgb[c] = Median(sun);
+    out.sky_rgb[c] = Median(sky);
+  }
+  return out;
+}
+
+}  // namespace
+
+FilteredLight TemporalFilter::Update(double time_s, const std::optional<SunSky>& fit, double confidence) {
+  if (last_time_s_ && time_s - *last_time_s_ > options_.restart_gap_s) {
+    window_.clear();
+    state_.reset();
+  }
+  last_time_s_ = time_s;
+  if (!fit || confidence < options_.min_confidence) {
+    if (state_) {
+      state_->confidence *= 1.0 - options_.smoothing;  // holding: trust fades
+      return *state_;
+    }
+    return FilteredLight{};
+  }
+  window_.push_back(*fit);
+  while (static_cast<int>(window_.size()) > options_.median_window) window_.pop_front();
+  if (!state_) {
+    state_ = FilteredLight{*fit, confidence};
+    return *state_;
+  }
+  // While the window fills after a restart, the median of what there is.
+  const SunSky target = WindowMedian(window_);
+  const double gain = options_.smoothing * std::clamp(confidence, 0.0, 1.0);
+  state_->light.sun_rgb += gain * (target.sun_rgb - state_->light.sun_rgb);
+  state_->light.sky_rgb += gain * (target.sky_rgb - state_->light.sky_rgb);
+  state_->confidence += options_.smoothing * (confidence - state_->confidence);
+  return *state_;
+}
+
+}  // namespace daylit::estimation

@@ -1,0 +1,69 @@
+#include "estimation/temporal_filter.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace daylit::estimation {
+namespace {
+
+SunSky Light(double sun, double sky) { return {glm::dvec3(sun), glm::dvec3(sky)}; }
+
+TEST(TemporalFilterTest, ACloudShowsWithinAFewFrames) {
+  // Clear sky, then a cloud leaves 20% of the beam at frame 10 (10 fps).
+  TemporalFilter filter;
+  std::vector<double> sun;
+  for (int f = 0; f < 20; ++f) {
+    sun.push_back(filter.Update(0.1 * f, Light(f < 10 ? 100.0 : 20.0, 10.0), 1.0).light.sun_rgb.x);
+  }
+  const auto reached = [&](int frame) { return (100.0 - sun[static_cast<size_t>(frame)]) / 80.0; };
+  EXPECT_NEAR(sun[9], 100.0, 1e-9);
+  EXPECT_NEAR(reached(10), 0.0, 1e-9);   // one new fit: the median still says clear
+  EXPECT_NEAR(reached(11), 0.5, 1e-9);   // half of the step after 1 frame of delay
+  EXPECT_NEAR(reached(12), 0.75, 1e-9);
+  EXPECT_GE(reached(14), 0.93);
+  EXPECT_GE(reached(19), 0.998);
+}
+
+TEST(TemporalFilterTest, ASingleFrameOutlierNeverPasses) {
+  TemporalFilter filter;
+  double worst = 0.0;
+  for (int f = 0; f < 30; ++f) {
+    const double raw = f == 15 ? 300.0 : 100.0;  // one wild fit
+    worst = std::max(worst, std::abs(filter.Update(0.1 * f, Light(raw, 10.0), 1.0).light.sun_rgb.x - 100.0));
+  }
+  EXPECT_LT(worst, 1e-9);
+}
+
+TEST(TemporalFilterTest, FrameToFrameNoiseIsReduced) {
+  TemporalFilter filter;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 3.0);
+  double raw_sq = 0.0, out_sq = 0.0;
+  int n = 0;
+  for (int f = 0; f < 3000; ++f) {
+    const double raw = 100.0 + noise(rng);
+    const double out = filter.Update(0.1 * f, Light(raw, 10.0), 1.0).light.sun_rgb.x;
+    if (f < 10) continue;
+    raw_sq += (raw - 100.0) * (raw - 100.0), out_sq += (out - 100.0) * (out - 100.0), ++n;
+  }
+  const double ratio = std::sqrt(out_sq / raw_sq);
+  EXPECT_LT(ratio, 0.55);  // half the flicker (measured 0.49)
+  EXPECT_GT(ratio, 0.3);   // and not frozen
+}
+
+TEST(TemporalFilterTest, GapsRestartAndMissingFitsHold) {
+  TemporalFilter filter;
+  for (int f = 0; f < 10; ++f) filter.Update(0.1 * f, Light(100.0, 10.0), 1.0);
+  const FilteredLight held = filter.Update(1.0, std::nullopt, 0.0);
+  EXPECT_DOUBLE_EQ(held.light.sun_rgb.x, 100.0);
+  EXPECT_LT(held.confidence, 1.0);  // holding, with fading trust
+  // The next burst, two hours later: no blending of morning into noon.
+  EXPECT_DOUBLE_EQ(filter.Update(7200.0, Light(300.0, 30.0), 0.9).light.sun_rgb.y, 300.0);
+  // A fit with no confidence does not move the estimate.
+  EXPECT_DOUBLE_EQ(filter.Update(7200.1, Light(0.0, 0.0), 0.0).light.sky_rgb.z, 30.0);
+}
+
+}  // namespace
+}  // namespace daylit::estimation
