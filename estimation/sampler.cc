@@ -1,0 +1,114 @@
+#include "estimation/sampler.h"
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <random>
+
+#include <opencv2/imgproc.hpp>
+
+#include "bake/surface_light.h"
+
+namespace daylit::estimation {
+
+Sampler::Sampler(const bake::CameraGBuffer& gbuffer, const scene::RayCaster& caster, SamplerOptions options)
+    : gbuffer_(gbuffer), caster_(caster), options_(options) {
+  for (size_t i = 0; i < gbuffer.diffuse.size(); ++i) {
+    if (gbuffer.diffuse[i]) diffuse_pixels_.push_back(static_cast<uint32_t>(i));
+  }
+  // A fixed order: the same pixels are read frame after frame, so sampling adds no flicker.
+  std::mt19937 rng(20060101u);
+  std::shuffle(diffuse_pixels_.begin(), diffuse_pixels_.end(), rng);
+  sunlit_.assign(gbuffer.diffuse.size(), 0);
+  near_boundary_.assign(gbuffer.diffuse.size(), 0);
+  sun_term_.assign(gbuffer.diffuse.size(), 0.0f);
+}
+
+bool Sampler::SetSun(const glm::vec3& sun_dir) {
+  if (sun_ && glm::degrees(std::acos(std::clamp(glm::dot(*sun_, sun_dir), -1.0f, 1.0f))) <= options_.recast_angle_deg) {
+    return false;
+  }
+  sun_ = sun_dir;
+  const int w = gbuffer_.width, h = gbuffer_.height;
+  // Sun visibility of every model pixel (not only diffuse ones), so that the shadow map in the
+  // image is the model's own.
+  std::vector<uint32_t> model_pixels;
+  for (size_t i = 0; i < gbuffer_.surface.size(); ++i) {
+    if (gbuffer_.surface[i] != bake::kNoSurface) model_pixels.push_back(static_cast<uint32_t>(i));
+  }
+  const size_t n = model_pixels.size();
+  std::vector<glm::vec3> points(n), normals(n);
+  for (size_t k = 0; k < n; ++k) points[k] = gbuffer_.point[model_pixels[k]], normals[k] = gbuffer_.normal[model_pixels[k]];
+  std::vector<uint8_t> visible(n, 0);
+  if (sun_dir.z > 0.0f) bake::SunVisibility(caster_, points.data(), normals.data(), n, sun_dir, 2e-3f, visible.data());
+  std::fill(sunlit_.begin(), sunlit_.end(), 0);
+  std::fill(sun_term_.begin(), sun_term_.end(), 0.0f);
+  cv::Mat lit(h, w, CV_8UC1, cv::Scalar(0));
+  cv::Mat surface(h, w, CV_32SC1, cv::Scalar(-1));
+  for (size_t k = 0; k < n; ++k) {
+    const uint32_t i = model_pixels[k];
+    sunlit_[i] = visible[k];
+    sun_term_[i] = visible[k] ? glm::dot(normals[k], sun_dir) : 0.0f;
+    lit.at<uint8_t>(static_cast<int>(i) / w, static_cast<int>(i) % w) = visible[k] ? 255 : 0;
+    surface.at<int32_t>(static_cast<int>(i) / w, static_cast<int>(i) % w) = static_cast<int32_t>(gbuffer_.surface[i]);
+  }
+  // Left out: pixels within the margin of a shadow edge (lit next to unlit) or of a silhouette
+  // (one surface next to another, or the sky): where the model and the image are misregistered
+  // by a pixel or two, these read the other side's light.
+  const int r = options_.boundary_margin_px;
+  cv::Mat near(h, w, CV_8UC1, cv::Scalar(0));
+  if (r > 0) {
+    cv::Mat edges(h, w, CV_8UC1, cv::Scalar(0));
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const int32_t s0 = surface.at<int32_t>(y, x);
+        const uint8_t l0 = lit.at<uint8_t>(y, x);
+        const bool right = x + 1 < w && (surface.at<int32_t>(y, x + 1) != s0 || lit.at<uint8_t>(y, x + 1) != l0);
+        const bool down = y + 1 < h && (surface.at<int32_t>(y + 1, x) != s0 || lit.at<uint8_t>(y + 1, x) != l0);
+        if (right || down) edges.at<uint8_t>(y, x) = 255;
+      }
+    }
+    cv::dilate(edges, near, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
+  }
+  // Strata: (surface, sunlit?) in the shuffled order.
+  std::map<std::pair<uint32_t, int>, size_t> index;
+  strata_.clear();
+  for (const uint32_t i : diffuse_pixels_) {
+    const bool boundary = near.at<uint8_t>(static_cast<int>(i) / w, static_cast<int>(i) % w) != 0;
+    near_boundary_[i] = boundary ? 1 : 0;
+    if (boundary) continue;
+    const auto key = std::make_pair(gbuffer_.surface[i], static_cast<int>(sunlit_[i]));
+    auto [it, inserted] = index.emplace(key, strata_.size());
+    if (inserted) strata_.emplace_back();
+    strata_[it->second].push_back(i);
+  }
+  return true;
+}
+
+std::vector<Sample> Sampler::Draw(const cv::Mat& linear, double exposure) const {
+  std::vector<Sample> samples;
+  if (strata_.empty() || linear.empty()) return samples;
+  samples.reserve(static_cast<size_t>(options_.samples));
+  const size_t quota = static_cast<size_t>(options_.samples) / strata_.size() + 1;
+  const float inv_exposure = static_cast<float>(1.0 / exposure);
+  for (const std::vector<uint32_t>& stratum : strata_) {
+    size_t taken = 0;
+    for (size_t k = 0; k < stratum.size() && taken < quota; ++k) {
+      const uint32_t i = stratum[k];
+      const cv::Vec3f& p = linear.at<cv::Vec3f>(static_cast<int>(i / gbuffer_.width), static_cast<int>(i % gbuffer_.width));
+      bool usable = true;
+      for (int c = 0; c < 3; ++c) usable = usable && p[c] < options_.saturated && p[c] > options_.near_black;
+      if (!usable) continue;
+      Sample s;
+      s.radiance = glm::vec3(p[0], p[1], p[2]) * inv_exposure;
+      s.albedo = gbuffer_.albedo[i];
+      s.sun = sun_term_[i];
+      s.sky = gbuffer_.sky_visibility[i];
+      samples.push_back(s);
+      ++taken;
+    }
+  }
+  return samples;
+}
+
+}  // namespace daylit::estimation

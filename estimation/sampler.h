@@ -1,0 +1,56 @@
+// Which camera pixels the per-frame fit reads. Stratified across surfaces and across sunlit and
+// shadowed areas (the two strata are what separates E_sun from E_sky), skipping pixels near a
+// shadow edge or a silhouette of the model (misregistration there is the main error source) and,
+// per frame, saturated and near-black pixels. The sun visibility behind the strata is re-cast only when the
+// sun has moved more than `recast_angle_deg`.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <opencv2/core.hpp>
+
+#include "bake/bake.h"
+#include "estimation/sun_sky_fit.h"
+#include "scene/raycaster.h"
+
+namespace daylit::estimation {
+
+struct SamplerOptions {
+  int samples = 8000;                // per frame, split evenly over the strata that exist
+  int boundary_margin_px = 3;        // pixels this close to a shadow edge or silhouette are left out
+  double recast_angle_deg = 0.05;    // re-cast sun visibility when the sun moved more than this
+  double saturated = 0.98;           // linear pixel value (before exposure) treated as clipped
+  double near_black = 0.002;         // linear pixel value below which noise dominates
+};
+
+class Sampler {
+ public:
+  Sampler(const bake::CameraGBuffer& gbuffer, const scene::RayCaster& caster, SamplerOptions options = {});
+
+  // Updates the strata for the sun direction `sun_dir` (unit, scene coordinates; z ≤ 0: night,
+  // everything is shadowed). Cheap when the sun has not moved enough. Returns true if it re-cast.
+  bool SetSun(const glm::vec3& sun_dir);
+
+  // Samples of one frame: `linear` is the frame as linear RGB floats (CV_32FC3, R G B order,
+  // before dividing out the exposure), `exposure` the k of "linear pixel = k · radiance".
+  std::vector<Sample> Draw(const cv::Mat& linear, double exposure) const;
+
+  size_t StratumCount() const { return strata_.size(); }
+  // The current sun visibility of each pixel (1: sunlit), and its boundary exclusion mask.
+  const std::vector<uint8_t>& sunlit() const { return sunlit_; }
+  const std::vector<uint8_t>& near_boundary() const { return near_boundary_; }
+
+ private:
+  const bake::CameraGBuffer& gbuffer_;
+  const scene::RayCaster& caster_;
+  SamplerOptions options_;
+  std::vector<uint32_t> diffuse_pixels_;  // in a fixed shuffled order
+  std::optional<glm::vec3> sun_;
+  std::vector<uint8_t> sunlit_, near_boundary_;
+  std::vector<float> sun_term_;  // s·max(0, n·l) per pixel
+  std::vector<std::vector<uint32_t>> strata_;  // pixel lists, each in the shuffled order
+};
+
+}  // namespace daylit::estimation

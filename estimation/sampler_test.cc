@@ -1,0 +1,109 @@
+#include "estimation/sampler.h"
+
+#include <gtest/gtest.h>
+
+#include <glm/gtc/constants.hpp>
+
+#include "bake/synthetic_recording.h"
+#include "base/log.h"
+
+namespace daylit::estimation {
+namespace {
+
+// A ground seen from 5 m above and a 3 m wall at x = 1; the sun 45° high in the +X direction
+// shades the ground for x in [-2, 1].
+struct WallScene {
+  bake::testing::SyntheticRecording rec{"sampler"};
+  scene::Scene scene;
+  bake::SceneBake bake;
+  std::unique_ptr<scene::RayCaster> caster;
+  const glm::vec3 sun = glm::normalize(glm::vec3(1.0f, 0.0f, 1.0f));
+
+  WallScene() {
+    SetLogVerbosity(0);
+    rec.obj += "o wall\nv 1 -10 0\nv 1 10 0\nv 1 10 3\nv 1 -10 3\nf 5 6 7 8\n";
+    scene = scene::LoadScene(rec.Write());
+    bake = bake::RunBake(scene, bake::BakeOptions{});
+    caster = std::make_unique<scene::RayCaster>(scene.model);
+  }
+
+  // The frame the model predicts for `light`, as linear RGB floats times `exposure`.
+  cv::Mat Render(const Sampler& sampler, const SunSky& light, double exposure) const {
+    const bake::CameraGBuffer& g = bake.camera;
+    cv::Mat frame(g.height, g.width, CV_32FC3, cv::Scalar(0, 0, 0));
+    for (size_t i = 0; i < g.surface.size(); ++i) {
+      if (g.surface[i] == bake::kNoSurface) continue;
+      const float a = sampler.sunlit()[i] ? std::max(0.0f, glm::dot(g.normal[i], sun)) : 0.0f;
+      const glm::dvec3 l = exposure * Radiance(glm::dvec3(g.albedo[i]), ShadingTerms{a, g.sky_visibility[i]}, light);
+      frame.at<cv::Vec3f>(static_cast<int>(i / g.width), static_cast<int>(i % g.width)) =
+          cv::Vec3f(static_cast<float>(l.x), static_cast<float>(l.y), static_cast<float>(l.z));
+    }
+    return frame;
+  }
+};
+
+TEST(SamplerTest, ExactSyntheticFrameIsRecoveredTo0_1Percent) {
+  const WallScene w;
+  Sampler sampler(w.bake.camera, *w.caster);
+  ASSERT_TRUE(sampler.SetSun(w.sun));
+  EXPECT_EQ(sampler.StratumCount(), 2u);  // ground sunlit, ground shadowed
+  const SunSky light{{86.0, 63.0, 37.0}, {9.9, 9.7, 10.0}};
+  const double exposure = 0.004;  // keeps sunlit ground (0.4/π·(86·0.71 + 9.9) ≈ 9) below clipping
+  const std::vector<Sample> samples = sampler.Draw(w.Render(sampler, light, exposure), exposure);
+  EXPECT_GT(samples.size(), 1500u);  // of 3072 pixels, less the shadow-edge and silhouette margins
+  const SunSkyFitSummary fit = FitSunSky({}, samples);
+  ASSERT_EQ(fit.status, SunSkyFitStatus::kConverged) << fit.message;
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(fit.light.sun_rgb[c], light.sun_rgb[c], 1e-3 * light.sun_rgb[c]) << c;
+    EXPECT_NEAR(fit.light.sky_rgb[c], light.sky_rgb[c], 1e-3 * light.sky_rgb[c]) << c;
+  }
+}
+
+TEST(SamplerTest, ShadowEdgesClippedAndDarkPixelsAreLeftOut) {
+  const WallScene w;
+  Sampler sampler(w.bake.camera, *w.caster);
+  sampler.SetSun(w.sun);
+  // The shadow edge at x = -2 runs across the image, and the wall's silhouette from x = 1 (its foot)
+  // to x = 2.5 (where its top hides the ground): only ground near those is excluded (3 px at
+  // 40 px per 5 m is 0.375 m).
+  size_t at_shadow = 0, at_wall = 0;
+  for (size_t i = 0; i < sampler.near_boundary().size(); ++i) {
+    if (!sampler.near_boundary()[i] || w.bake.camera.surface[i] != 0) continue;
+    const float x = w.bake.camera.point[i].x;
+    const bool shadow_edge = std::abs(x + 2.0f) < 0.5f, wall = x > 0.5f && x < 3.0f;
+    EXPECT_TRUE(shadow_edge || wall) << x;
+    at_shadow += shadow_edge, at_wall += wall;
+  }
+  EXPECT_GT(at_shadow, 48u * 4u);  // both sides of the edge, the whole image height
+  EXPECT_GT(at_wall, 48u * 4u);
+  // Clipped and black pixels are skipped.
+  const SunSky light{{86.0, 63.0, 37.0}, {9.9, 9.7, 10.0}};
+  cv::Mat frame = w.Render(sampler, light, 0.004);
+  const size_t all = sampler.Draw(frame, 0.004).size();
+  frame.setTo(cv::Scalar(1.0f, 1.0f, 1.0f), cv::Mat(frame.size(), CV_8UC1, cv::Scalar(0)));
+  cv::Mat clipped = frame.clone();
+  clipped.rowRange(0, 24).setTo(cv::Scalar(1.0f, 1.0f, 1.0f));  // half the image clipped
+  EXPECT_LT(sampler.Draw(clipped, 0.004).size(), all);
+  EXPECT_TRUE(sampler.Draw(cv::Mat(frame.size(), CV_32FC3, cv::Scalar(0, 0, 0)), 0.004).empty());
+}
+
+TEST(SamplerTest, SunVisibilityIsRecastOnlyWhenTheSunMoves) {
+  const WallScene w;
+  Sampler sampler(w.bake.camera, *w.caster);
+  EXPECT_TRUE(sampler.SetSun(w.sun));
+  const glm::vec3 tiny = glm::normalize(w.sun + glm::vec3(0.0f, 0.0005f, 0.0f));  // 0.02°
+  EXPECT_FALSE(sampler.SetSun(tiny));
+  const glm::vec3 moved = glm::normalize(w.sun + glm::vec3(0.0f, 0.005f, 0.0f));  // 0.2°
+  EXPECT_TRUE(sampler.SetSun(moved));
+  // Night: everything is shadowed, one stratum, and the fit is sky only.
+  EXPECT_TRUE(sampler.SetSun(glm::vec3(0.0f, 0.0f, -1.0f)));
+  EXPECT_EQ(sampler.StratumCount(), 1u);
+  const SunSky night{{0, 0, 0}, {0.5, 0.6, 0.9}};
+  const std::vector<Sample> samples = sampler.Draw(w.Render(sampler, night, 0.1), 0.1);
+  const SunSkyFitSummary fit = FitSunSky({}, samples);
+  EXPECT_EQ(fit.status, SunSkyFitStatus::kSkyOnly);
+  EXPECT_NEAR(fit.light.sky_rgb.z, 0.9, 0.9e-3);
+}
+
+}  // namespace
+}  // namespace daylit::estimation
