@@ -4,6 +4,7 @@ find_package(PkgConfig REQUIRED)
 
 find_package(OpenCV 4.6 REQUIRED COMPONENTS core imgproc imgcodecs videoio calib3d)
 pkg_check_modules(LIBV4L2 REQUIRED IMPORTED_TARGET libv4l2)
+pkg_check_modules(LIBAV REQUIRED IMPORTED_TARGET libavformat libavcodec libavutil)
 pkg_check_modules(GEOGRAPHICLIB REQUIRED IMPORTED_TARGET geographiclib>=2.1)
 find_package(Ceres 2.1 REQUIRED CONFIG)
 find_package(Eigen3 3.4 REQUIRED CONFIG)

@@ -6,7 +6,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkgconf git
-  libopencv-dev libv4l-dev libgeographiclib-dev libceres-dev libeigen3-dev libunwind-dev
+  libopencv-dev libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libv4l-dev libgeographiclib-dev libceres-dev libeigen3-dev libunwind-dev
   libglm-dev libglfw3-dev libegl-dev libgl-dev libgles-dev libepoxy-dev libegl-mesa0
   libgl1-mesa-dri libgbm-dev libopenexr-dev libimath-dev libembree-dev libtbb-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
