@@ -19,6 +19,10 @@ struct CameraResponse {
   // ToLinear for the 256 codes of an 8-bit image, code / 255 as the encoded value.
   std::array<float, 256> LinearLut8() const;
   std::string Describe() const;  // "srgb", "linear", "gamma 2.2"
+
+  // Linear floats of an encoded float image (any channel count, values in [0, 1]), through a
+  // 4097-entry table with linear interpolation (exact to 1e-5 of the curve).
+  void Linearize(const float* encoded, float* linear, size_t count) const;
 };
 
 }  // namespace daylit::capture

@@ -25,5 +25,13 @@ TEST(ResponseTest, EveryCurveRoundTrips) {
   EXPECT_NEAR((CameraResponse{ResponseCurve::kGamma, 2.0}.ToLinear(0.5)), 0.25, 1e-12);
 }
 
+TEST(ResponseTest, TableLinearizationFollowsTheCurve) {
+  const CameraResponse srgb;
+  std::vector<float> encoded(10001), linear(encoded.size());
+  for (size_t i = 0; i < encoded.size(); ++i) encoded[i] = static_cast<float>(i) / 10000.0f;
+  srgb.Linearize(encoded.data(), linear.data(), encoded.size());
+  for (size_t i = 0; i < encoded.size(); ++i) ASSERT_NEAR(linear[i], srgb.ToLinear(encoded[i]), 1e-5) << encoded[i];
+}
+
 }  // namespace
 }  // namespace daylit::capture

@@ -30,7 +30,9 @@ FilteredLight TemporalFilter::Update(double time_s, const std::optional<SunSky>&
     state_.reset();
   }
   last_time_s_ = time_s;
-  if (!fit || confidence < options_.min_confidence) {
+  // Until a first fit arrives there is nothing to hold, so the first usable fit starts the filter
+  // whatever its confidence; later, fits below min_confidence do not move the estimate.
+  if (!fit || (state_ && confidence < options_.min_confidence)) {
     if (state_) {
       state_->confidence *= 1.0 - options_.smoothing;  // holding: trust fades
       return *state_;
@@ -45,7 +47,9 @@ FilteredLight TemporalFilter::Update(double time_s, const std::optional<SunSky>&
   }
   // While the window fills after a restart, the median of what there is.
   const SunSky target = WindowMedian(window_);
-  const double gain = options_.smoothing * std::clamp(confidence, 0.0, 1.0);
+  // A fixed gain: the confidence gates frames (above), it does not slow the filter. A scene
+  // whose model fits only to 20% still follows a cloud frame by frame.
+  const double gain = options_.smoothing;
   state_->light.sun_rgb += gain * (target.sun_rgb - state_->light.sun_rgb);
   state_->light.sky_rgb += gain * (target.sky_rgb - state_->light.sky_rgb);
   state_->confidence += options_.smoothing * (confidence - state_->confidence);

@@ -63,6 +63,9 @@ TEST(TemporalFilterTest, GapsRestartAndMissingFitsHold) {
   EXPECT_DOUBLE_EQ(filter.Update(7200.0, Light(300.0, 30.0), 0.9).light.sun_rgb.y, 300.0);
   // A fit with no confidence does not move the estimate.
   EXPECT_DOUBLE_EQ(filter.Update(7200.1, Light(0.0, 0.0), 0.0).light.sky_rgb.z, 30.0);
+  // But the very first fit starts a filter, however unsure: there is nothing else to report.
+  TemporalFilter fresh;
+  EXPECT_DOUBLE_EQ(fresh.Update(0.0, Light(50.0, 5.0), 0.01).light.sun_rgb.x, 50.0);
 }
 
 }  // namespace

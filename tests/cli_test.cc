@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "bake/synthetic_recording.h"
+#include "capture/response.h"
 #include "base/atomic_file.h"
 #include "base/csv.h"
 #include "scene/scene_test_util.h"
@@ -145,6 +146,25 @@ TEST(CliTest, BakePrintsAlbedoUsesItsCacheAndRebakesOnChange) {
   EXPECT_NE(third.err.find("baked"), std::string::npos) << third.err;
   EXPECT_EQ(third.err.find("loaded"), std::string::npos) << third.err;
   EXPECT_NEAR(ParseFiniteDouble(ParseCsv(third.out, "stdout").rows[0][1], "r"), 0.3, 0.003);  // 0.6 / 2
+}
+
+TEST(CliTest, EstimateWritesTheStableCsv) {
+  // One flat grey frame (code 120) of open ground (albedo 0.4, V = 1) at night: sky only, and
+  // the model gives E_sky = π·L/ρ with L the frame's linear value (exposure 1).
+  bake::testing::SyntheticRecording rec("cli_estimate");
+  const std::string scene = rec.Write().string();
+  const fs::path out = rec.dir / "est.csv";
+  const CliRun run = Daylit("estimate " + scene + " --cache " + (rec.dir / "cache").string() + " --out " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const CsvTable table = ReadCsvFile(out);
+  EXPECT_EQ(table.header, (std::vector<std::string>{"frame", "time_utc", "sun_elevation_deg", "sun_azimuth_deg", "sun_r",
+                                                     "sun_g", "sun_b", "sky_r", "sky_g", "sky_b", "confidence", "samples"}));
+  ASSERT_EQ(table.rows.size(), 1u);
+  const double linear = capture::CameraResponse{}.ToLinear(120.0 / 255.0);
+  EXPECT_NEAR(ParseFiniteDouble(table.rows[0][7], "sky_r"), M_PI * linear / 0.4, 0.01 * M_PI * linear / 0.4);
+  EXPECT_EQ(ParseFiniteDouble(table.rows[0][4], "sun_r"), 0.0);
+  EXPECT_LT(ParseFiniteDouble(table.rows[0][2], "elevation"), 0.0);  // midnight at (0°, 0°)
+  EXPECT_TRUE(fs::is_regular_file(rec.dir / "est.png"));
 }
 
 struct BadCall {

@@ -9,5 +9,6 @@ namespace daylit::app {
 void AddSunposCommand(CLI::App& app);
 void AddInfoCommand(CLI::App& app);
 void AddBakeCommand(CLI::App& app);
+void AddEstimateCommand(CLI::App& app);
 
 }  // namespace daylit::app

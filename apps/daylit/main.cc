@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   daylit::app::AddSunposCommand(app);
   daylit::app::AddInfoCommand(app);
   daylit::app::AddBakeCommand(app);
+  daylit::app::AddEstimateCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

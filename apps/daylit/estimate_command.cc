@@ -1,0 +1,67 @@
+#include <optional>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "apps/daylit/commands.h"
+#include "bake/bake.h"
+#include "base/atomic_file.h"
+#include "base/log.h"
+#include "estimation/recording_estimator.h"
+#include "scene/scene.h"
+
+namespace daylit::app {
+namespace {
+
+struct EstimateCommandOptions {
+  std::string recording;
+  std::string cache;
+  std::string out = "estimates.csv";
+  std::string plot;
+  estimation::EstimateOptions estimate;
+};
+
+void RunEstimateCommand(const EstimateCommandOptions& o) {
+  const scene::Scene scene = scene::LoadScene(o.recording);
+  const std::filesystem::path dir =
+      bake::CacheDir(scene, o.cache.empty() ? std::nullopt : std::optional<std::filesystem::path>(o.cache));
+  bool loaded = false;
+  const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, dir, &loaded);
+  Log().info("{} the bake: {}", loaded ? "loaded" : "made", dir.string());
+  const estimation::EstimateRun run = estimation::EstimateRecording(scene, baked, o.estimate);
+  WriteFileAtomically(o.out, estimation::EstimatesCsv(run.frames));
+  const size_t n = run.frames.size();
+  Log().info("{} frames in {:.2f} s ({:.0f} fps end to end; estimation after decoding {:.2f} ms per frame); wrote {}",
+             n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9),
+             1e3 * run.estimate_seconds / static_cast<double>(std::max<size_t>(n, 1)), o.out);
+  if (run.undecodable > 0) Log().warn("{} frames could not be decoded", run.undecodable);
+  const std::string plot = o.plot.empty() ? std::filesystem::path(o.out).replace_extension(".png").string() : o.plot;
+  std::optional<estimation::TruthComparison> truth;
+  if (scene.groundtruth.lighting) {
+    truth = estimation::CompareWithTruth(run.frames, *scene.groundtruth.lighting);
+    fmt::print("median relative error over {} frames (R, G, B):\n", truth->frames);
+    fmt::print("  E_sun      {:5.1f}% {:5.1f}% {:5.1f}%\n", 100 * truth->sun_error.x, 100 * truth->sun_error.y, 100 * truth->sun_error.z);
+    fmt::print("  E_sky      {:5.1f}% {:5.1f}% {:5.1f}%\n", 100 * truth->sky_error.x, 100 * truth->sky_error.y, 100 * truth->sky_error.z);
+    fmt::print("  sun/sky    {:5.1f}% {:5.1f}% {:5.1f}%\n", 100 * truth->ratio_error.x, 100 * truth->ratio_error.y, 100 * truth->ratio_error.z);
+  }
+  estimation::PlotEstimates(run.frames, truth ? &*truth : nullptr, scene.name, plot);
+  Log().info("wrote {}", plot);
+}
+
+}  // namespace
+
+void AddEstimateCommand(CLI::App& app) {
+  auto options = std::make_shared<EstimateCommandOptions>();
+  CLI::App* cmd = app.add_subcommand("estimate", "Sun and sky RGB irradiance for every frame (headless, no GL)");
+  cmd->footer("Bakes first when the cache is missing or stale. Writes the CSV (frame,time_utc,sun_elevation_deg,\n"
+              "sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,sky_g,sky_b,confidence,samples) and a plot; with ground\n"
+              "truth, prints the median errors.");
+  cmd->add_option("recording", options->recording, "Recording folder or its scene.json")->required();
+  cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
+  cmd->add_option("--out", options->out, "Estimates CSV (default estimates.csv)");
+  cmd->add_option("--plot", options->plot, "Plot PNG (default: the CSV's name with .png)");
+  cmd->add_option("--samples", options->estimate.sampler.samples, "Samples per frame (default 8000)");
+  cmd->callback([options] { RunEstimateCommand(*options); });
+}
+
+}  // namespace daylit::app

@@ -1,0 +1,198 @@
+#include "estimation/recording_estimator.h"
+
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "base/csv.h"
+#include "base/error.h"
+#include "base/log.h"
+#include "base/progress.h"
+#include "capture/video_decoder.h"
+#include "report/plot.h"
+#include "scene/hdr_image.h"
+#include "sunmodel/solar_position.h"
+
+namespace daylit::estimation {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::nth_element(v.begin(), v.begin() + static_cast<ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// Frames in order, as linear RGB floats; one source for videos and image sequences.
+class FrameReader {
+ public:
+  explicit FrameReader(const scene::Scene& scene) : scene_(scene) {
+    if (scene.frames.kind == scene::FrameSourceKind::kVideo) video_ = std::make_unique<capture::VideoDecoder>(scene.frames.video);
+  }
+  // Returns false when frame `index` cannot be read (decoded is then empty).
+  bool Read(int index, cv::Mat* linear) {
+    cv::Mat encoded;
+    if (video_) {
+      if (!video_->Next(&encoded)) return false;
+    } else {
+      const std::filesystem::path path = scene_.frames.ImagePath(index);
+      if (path.extension() == ".exr") {
+        scene::HdrImage image = scene::ReadHdrImage(path);  // already linear
+        cv::Mat(image.height, image.width, CV_32FC3, image.rgb.data()).copyTo(*linear);
+        return true;
+      }
+      const cv::Mat bgr = cv::imread(path.string(), cv::IMREAD_COLOR);
+      if (bgr.empty()) return false;
+      cv::Mat rgb;
+      cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+      rgb.convertTo(encoded, CV_32FC3, 1.0 / 255.0);
+    }
+    linear->create(encoded.size(), CV_32FC3);
+    scene_.response.Linearize(encoded.ptr<float>(), linear->ptr<float>(), encoded.total() * 3);
+    return true;
+  }
+
+ private:
+  const scene::Scene& scene_;
+  std::unique_ptr<capture::VideoDecoder> video_;
+};
+
+}  // namespace
+
+EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& bake, const EstimateOptions& options) {
+  if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames to estimate", scene.file.string());
+  const scene::RayCaster caster(scene.model);
+  Sampler sampler(bake.camera, caster, options.sampler);
+  TemporalFilter filter(options.filter);
+  FrameReader reader(scene);
+  const sunmodel::Atmosphere atmosphere = sunmodel::Atmosphere::Standard(scene.location.elevation_m);
+  const sunmodel::SceneGeoFrame geo = scene.GeoFrame();
+  const std::vector<capture::FrameTime>& times = scene.frame_times->frames;
+  EstimateRun run;
+  Progress progress("estimate", times.size());
+  const Clock::time_point start = Clock::now();
+  double estimate_s = 0.0;
+  cv::Mat linear;
+  for (size_t i = 0; i < times.size(); ++i) {
+    FrameEstimate row;
+    row.frame = times[i].index;
+    row.time_utc = times[i].utc;
+    const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(times[i].utc, scene.location, atmosphere, {});
+    row.sun_elevation_deg = sun.ApparentElevationDeg();
+    row.sun_azimuth_deg = sun.azimuth_deg;
+    const double t_s = times[i].utc.SecondsSince(times.front().utc);
+    if (!reader.Read(row.frame, &linear) || linear.cols != bake.camera.width || linear.rows != bake.camera.height) {
+      row.decoded = false;
+      ++run.undecodable;
+      Log().warn("{}: frame {} cannot be decoded; skipped", scene.file.string(), row.frame);
+      const FilteredLight held = filter.Update(t_s, std::nullopt, 0.0);
+      row.light = held.light, row.confidence = held.confidence;
+      run.frames.push_back(row);
+      progress.Advance();
+      continue;
+    }
+    const Clock::time_point decoded = Clock::now();
+    sampler.SetSun(glm::vec3(geo.DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg)));
+    const std::vector<Sample> samples = sampler.Draw(linear, times[i].exposure.value_or(scene.exposure));
+    const SunSkyFitSummary fit = FitSunSky(options.fit, samples);
+    const FilteredLight filtered =
+        filter.Update(t_s, fit.IsUsable() ? std::optional<SunSky>(fit.light) : std::nullopt, fit.confidence);
+    estimate_s += std::chrono::duration<double>(Clock::now() - decoded).count();
+    row.light = filtered.light;
+    row.confidence = filtered.confidence;
+    row.samples = static_cast<int>(samples.size());
+    run.frames.push_back(row);
+    progress.Advance();
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    progress.SetSuffix(fmt::format("{:.0f} fps", static_cast<double>(i + 1) / std::max(elapsed, 1e-9)));
+  }
+  run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  run.estimate_seconds = estimate_s;
+  return run;
+}
+
+std::string EstimatesCsv(const std::vector<FrameEstimate>& frames) {
+  fmt::memory_buffer out;
+  fmt::format_to(std::back_inserter(out), "frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,"
+                                          "sky_g,sky_b,confidence,samples\n");
+  for (const FrameEstimate& f : frames) {
+    fmt::format_to(std::back_inserter(out), "{},{},{:.4f},{:.4f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{}\n",
+                   f.frame, FormatUtcTime(f.time_utc), f.sun_elevation_deg, f.sun_azimuth_deg, f.light.sun_rgb.x,
+                   f.light.sun_rgb.y, f.light.sun_rgb.z, f.light.sky_rgb.x, f.light.sky_rgb.y, f.light.sky_rgb.z,
+                   f.confidence, f.samples);
+  }
+  return fmt::to_string(out);
+}
+
+TruthComparison CompareWithTruth(const std::vector<FrameEstimate>& frames, const std::filesystem::path& groundtruth_csv) {
+  const CsvTable table = ReadCsvFile(groundtruth_csv);
+  const size_t c_frame = static_cast<size_t>(table.RequireColumn("frame"));
+  std::array<size_t, 6> c{};
+  const char* names[6] = {"sun_r", "sun_g", "sun_b", "sky_r", "sky_g", "sky_b"};
+  for (size_t k = 0; k < 6; ++k) c[k] = static_cast<size_t>(table.RequireColumn(names[k]));
+  std::map<int, SunSky> truth_by_frame;
+  for (size_t r = 0; r < table.rows.size(); ++r) {
+    SunSky t;
+    for (int k = 0; k < 3; ++k) {
+      t.sun_rgb[k] = ParseFiniteDouble(table.rows[r][c[static_cast<size_t>(k)]], table.Where(r));
+      t.sky_rgb[k] = ParseFiniteDouble(table.rows[r][c[static_cast<size_t>(k) + 3]], table.Where(r));
+    }
+    truth_by_frame[static_cast<int>(ParseFiniteDouble(table.rows[r][c_frame], table.Where(r)))] = t;
+  }
+  TruthComparison cmp;
+  std::array<std::vector<double>, 3> sun, sky, ratio;
+  for (const FrameEstimate& f : frames) {
+    const auto it = truth_by_frame.find(f.frame);
+    cmp.truth.push_back(it == truth_by_frame.end() ? SunSky{glm::dvec3(NAN), glm::dvec3(NAN)} : it->second);
+    if (it == truth_by_frame.end() || !f.decoded) continue;
+    ++cmp.frames;
+    for (int k = 0; k < 3; ++k) {
+      const double ts = it->second.sun_rgb[k], tk = it->second.sky_rgb[k];
+      if (tk > 0) sky[static_cast<size_t>(k)].push_back(std::abs(f.light.sky_rgb[k] / tk - 1.0));
+      if (ts > 0) sun[static_cast<size_t>(k)].push_back(std::abs(f.light.sun_rgb[k] / ts - 1.0));
+      if (ts > 0 && tk > 0 && f.light.sky_rgb[k] > 0) {
+        ratio[static_cast<size_t>(k)].push_back(std::abs((f.light.sun_rgb[k] / f.light.sky_rgb[k]) / (ts / tk) - 1.0));
+      }
+    }
+  }
+  for (int k = 0; k < 3; ++k) {
+    cmp.sun_error[k] = Median(sun[static_cast<size_t>(k)]);
+    cmp.sky_error[k] = Median(sky[static_cast<size_t>(k)]);
+    cmp.ratio_error[k] = Median(ratio[static_cast<size_t>(k)]);
+  }
+  return cmp;
+}
+
+void PlotEstimates(const std::vector<FrameEstimate>& frames, const TruthComparison* truth, const std::string& title,
+                   const std::filesystem::path& png) {
+  std::vector<cv::Mat> panels;
+  for (const bool sun : {true, false}) {
+    report::LinePlot plot({sun ? title + ": E_sun (DNI), estimate solid, truth dashed" : "E_sky (DHI)",
+                           sun ? "" : "frame", "radiance units", 1400, 360, true});
+    for (int k = 0; k < 3; ++k) {
+      const std::array<int, 3> color = k == 0 ? std::array<int, 3>{214, 39, 40} : k == 1 ? std::array<int, 3>{44, 160, 44}
+                                                                                          : std::array<int, 3>{31, 119, 180};
+      report::Series est{std::string(1, "RGB"[k]), {}, {}, color, false, false};
+      report::Series tru{std::string(1, "RGB"[k]) + " truth", {}, {}, color, true, false};
+      for (size_t i = 0; i < frames.size(); ++i) {
+        est.x.push_back(frames[i].frame);
+        est.y.push_back(sun ? frames[i].light.sun_rgb[k] : frames[i].light.sky_rgb[k]);
+        if (truth != nullptr) {
+          tru.x.push_back(frames[i].frame);
+          tru.y.push_back(sun ? truth->truth[i].sun_rgb[k] : truth->truth[i].sky_rgb[k]);
+        }
+      }
+      plot.Add(std::move(est));
+      if (truth != nullptr) plot.Add(std::move(tru));
+    }
+    panels.push_back(plot.Render());
+  }
+  report::WritePng(png, panels);
+}
+
+}  // namespace daylit::estimation

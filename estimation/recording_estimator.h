@@ -1,0 +1,64 @@
+// Estimation over a whole recording (`daylit estimate`): for each frame, the sun from the
+// ephemeris, the sampler's strata (re-cast only when the sun has moved), the robust fit, the
+// temporal filter. Headless: no GL. The controller owns the loop; the estimators stay stateless.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bake/bake.h"
+#include "estimation/sampler.h"
+#include "estimation/sun_sky_fit.h"
+#include "estimation/temporal_filter.h"
+#include "scene/scene.h"
+
+namespace daylit::estimation {
+
+struct EstimateOptions {
+  SamplerOptions sampler;
+  SunSkyFitOptions fit;
+  TemporalFilterOptions filter;
+};
+
+struct FrameEstimate {
+  int frame = 0;
+  UtcTime time_utc;
+  double sun_elevation_deg = 0.0;  // apparent
+  double sun_azimuth_deg = 0.0;    // east of north
+  SunSky light;                    // filtered E_sun, E_sky (radiance units, exposure divided out)
+  double confidence = 0.0;
+  int samples = 0;
+  bool decoded = true;             // false: the frame could not be decoded (the estimate holds)
+};
+
+struct EstimateRun {
+  std::vector<FrameEstimate> frames;
+  int undecodable = 0;
+  double seconds = 0.0;         // wall time of the loop, decoding included
+  double estimate_seconds = 0.0;  // of which: everything after decoding
+};
+
+// Runs over every frame of a recorded scene (video or images). Throws InputError for a scene
+// without recorded frames (a live device).
+EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& bake, const EstimateOptions& options);
+
+// The stable CSV: frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,sky_g,
+// sky_b,confidence,samples.
+std::string EstimatesCsv(const std::vector<FrameEstimate>& frames);
+
+// Against groundtruth.csv: median over frames of |estimate/truth − 1| per channel, for E_sun
+// (frames where the true E_sun is > 0), E_sky, and the sun/sky ratio.
+struct TruthComparison {
+  glm::dvec3 sun_error{0.0}, sky_error{0.0}, ratio_error{0.0};
+  int frames = 0;
+  std::vector<SunSky> truth;  // per frame, aligned with the estimates
+};
+TruthComparison CompareWithTruth(const std::vector<FrameEstimate>& frames, const std::filesystem::path& groundtruth_csv);
+
+// Estimate vs truth over time, per channel: a PNG with a sun panel and a sky panel.
+void PlotEstimates(const std::vector<FrameEstimate>& frames, const TruthComparison* truth,
+                   const std::string& title, const std::filesystem::path& png);
+
+}  // namespace daylit::estimation
