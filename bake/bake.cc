@@ -12,6 +12,7 @@
 
 #include "bake/sampling.h"
 #include "base/error.h"
+#include "base/statistics.h"
 #include "base/log.h"
 #include "scene/latlong.h"
 #include "scene/raycaster.h"
@@ -23,13 +24,6 @@ namespace {
 // Rays from the capture point: if none reaches the sky and most hit the back of a face, the
 // point is inside closed geometry.
 constexpr double kInsideBackFaceShare = 0.5;
-
-float Median(std::vector<float>* values) {
-  if (values->empty()) return 0.0f;
-  auto mid = values->begin() + static_cast<ptrdiff_t>(values->size() / 2);
-  std::nth_element(values->begin(), mid, values->end());
-  return *mid;
-}
 
 glm::dvec3 SunAtCapture(const scene::Scene& scene) {
   const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(
@@ -70,8 +64,8 @@ HiddenSurfaceModel SurfaceModelFrom(const scene::SceneModel& model, const std::v
   hidden.indirect.assign(surfaces, glm::vec3(0.0f));
   for (size_t s = 0; s < surfaces; ++s) {
     for (int c = 0; c < 3; ++c) {
-      hidden.albedo[s][c] = Median(&values[s][static_cast<size_t>(c)]);
-      hidden.indirect[s][c] = Median(&values[s][3 + static_cast<size_t>(c)]);
+      hidden.albedo[s][c] = MedianInPlace(values[s][static_cast<size_t>(c)], 0.0f);
+      hidden.indirect[s][c] = MedianInPlace(values[s][3 + static_cast<size_t>(c)], 0.0f);
     }
   }
   return hidden;
@@ -166,7 +160,7 @@ std::vector<SurfaceAlbedo> AlbedoTable(const scene::SceneModel& model, const Env
   std::vector<SurfaceAlbedo> table;
   for (size_t s = 0; s < model.surface_names.size(); ++s) {
     SurfaceAlbedo row{model.surface_names[s], glm::vec3(0.0f), values[s][0].size()};
-    for (size_t c = 0; c < 3; ++c) row.albedo[static_cast<int>(c)] = Median(&values[s][c]);
+    for (size_t c = 0; c < 3; ++c) row.albedo[static_cast<int>(c)] = MedianInPlace(values[s][c], 0.0f);
     table.push_back(row);
   }
   return table;

@@ -11,6 +11,7 @@
 #include "base/csv.h"
 #include "base/error.h"
 #include "base/log.h"
+#include "base/statistics.h"
 #include "base/progress.h"
 #include "capture/video_decoder.h"
 #include "report/plot.h"
@@ -22,11 +23,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::nth_element(v.begin(), v.begin() + static_cast<ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
+double Median(std::vector<double> v) { return MedianInPlace(v, static_cast<double>(NAN)); }
 
 // Frames in order, as linear RGB floats; one source for videos and image sequences.
 class FrameReader {

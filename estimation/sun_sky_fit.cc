@@ -1,5 +1,7 @@
 #include "estimation/sun_sky_fit.h"
 
+#include "base/statistics.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -11,12 +13,7 @@ namespace {
 
 constexpr int kMinSamples = 10;
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
+double Median(std::vector<double> v) { return MedianInPlace(v, 0.0); }
 
 struct ChannelFit {
   double sun = 0.0, sky = 0.0;

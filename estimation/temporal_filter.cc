@@ -1,15 +1,14 @@
 #include "estimation/temporal_filter.h"
 
+#include "base/statistics.h"
+
 #include <algorithm>
 #include <vector>
 
 namespace daylit::estimation {
 namespace {
 
-double Median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
+double Median(std::vector<double> v) { return MedianInPlace(v, 0.0); }
 
 SunSky WindowMedian(const std::deque<SunSky>& window) {
   SunSky out;
