@@ -104,8 +104,8 @@ void SaveBake(const SceneBake& bake, const scene::Scene& scene, const BakeOption
 // Loads a bake from `dir` if its bake.json carries `hash`; nullopt when missing or stale.
 std::optional<SceneBake> LoadBake(const std::filesystem::path& dir, const std::string& hash);
 
-// `dir` if given, else $XDG_CACHE_HOME/daylit/<scene name> (~/.cache/daylit/<name>).
-std::filesystem::path CacheDir(const scene::Scene& scene, const std::optional<std::filesystem::path>& dir);
+// `dir` unless empty, else $XDG_CACHE_HOME/daylit/<scene name> (~/.cache/daylit/<name>).
+std::filesystem::path CacheDir(const scene::Scene& scene, const std::filesystem::path& dir);
 
 // The cached bake when its hash matches, else a new one (saved). `loaded` tells which.
 SceneBake BakeOrLoad(const scene::Scene& scene, const BakeOptions& options, const std::filesystem::path& dir,

@@ -135,8 +135,8 @@ std::string AlbedoCsv(const std::vector<SurfaceAlbedo>& table) {
   return out;
 }
 
-fs::path CacheDir(const scene::Scene& scene, const std::optional<fs::path>& dir) {
-  if (dir) return *dir;
+fs::path CacheDir(const scene::Scene& scene, const fs::path& dir) {
+  if (!dir.empty()) return dir;
   const char* xdg = std::getenv("XDG_CACHE_HOME");
   const char* home = std::getenv("HOME");
   const fs::path base = xdg != nullptr && *xdg != '\0' ? fs::path(xdg)

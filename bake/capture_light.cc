@@ -16,10 +16,13 @@ float Luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] +
 
 }  // namespace
 
-glm::vec3 Lookup(const scene::HdrImage& env, const glm::vec3& dir) {
-  const int texel = scene::LatLongTexel(glm::dvec3(dir), env.width, env.height);
+glm::vec3 TexelRadiance(const scene::HdrImage& env, int texel) {
   const float* p = &env.rgb[static_cast<size_t>(texel) * 3];
   return {p[0], p[1], p[2]};
+}
+
+glm::vec3 Lookup(const scene::HdrImage& env, const glm::vec3& dir) {
+  return TexelRadiance(env, scene::LatLongTexel(glm::dvec3(dir), env.width, env.height));
 }
 
 CaptureSun ExtractSun(scene::HdrImage* env, const glm::dvec3& sun_dir, const std::optional<glm::dvec3>& given_dni,

@@ -43,7 +43,8 @@ CaptureSun ExtractSun(scene::HdrImage* env, const glm::dvec3& sun_dir, const std
 // radiance) from the known bins around them.
 scene::HdrImage SkyOnly(const scene::HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir);
 
-// Nearest-texel radiance of a lat-long map in direction `dir`.
+// Nearest-texel radiance of a lat-long map in direction `dir`, and of texel index `texel`.
 glm::vec3 Lookup(const scene::HdrImage& env, const glm::vec3& dir);
+glm::vec3 TexelRadiance(const scene::HdrImage& env, int texel);
 
 }  // namespace daylit::bake

@@ -23,12 +23,20 @@ glm::mat3 FrameFor(const glm::vec3& normal, size_t index) {
   return BasisAround(normal) * spin;
 }
 
+// E_sun·s·max(0, n·l) at a point with unit normal `normal`, the shadow ray leaving from
+// `origin` (the point, already moved off its surface).
+glm::vec3 DirectSun(const CaptureScene& capture, const glm::vec3& origin, const glm::vec3& normal) {
+  const CaptureSun& sun = capture.sun;
+  const float cos_sun = glm::dot(normal, sun.dir);
+  if (!sun.above_horizon || cos_sun <= 0.0f || capture.caster->Occluded(origin, sun.dir)) return glm::vec3(0.0f);
+  return sun.dni_rgb * cos_sun;
+}
+
 // Radiance of model point y (hit by a ray, with `hit`'s surface and normal) at capture time.
 glm::vec3 RadianceAt(const CaptureScene& capture, const glm::vec3& y, const scene::RayHit& hit) {
   const glm::vec3 toward = y - capture.capture_position;
   const int texel = scene::LatLongTexel(glm::dvec3(toward), capture.env->width, capture.env->height);
-  const float* p = &capture.env->rgb[static_cast<size_t>(texel) * 3];
-  const glm::vec3 texel_radiance(p[0], p[1], p[2]);
+  const glm::vec3 texel_radiance = TexelRadiance(*capture.env, texel);
   if (capture.hidden == nullptr || capture.env_distance == nullptr) return texel_radiance;
   // The capture point sees y unless its own ray toward y stops clearly short of it. The texel's
   // ray can be up to a texel off y's direction; on y's own surface seen at a grazing angle that
@@ -40,12 +48,7 @@ glm::vec3 RadianceAt(const CaptureScene& capture, const glm::vec3& y, const scen
   const float obliquity = std::max(0.05f, std::abs(glm::dot(hit.normal, toward / distance)));
   const float slack = 0.05f + distance * texel_angle * (same_surface ? 2.0f / obliquity : 2.0f);
   if (seen >= 0.0f && seen >= distance - slack) return texel_radiance;
-  const CaptureSun& sun = capture.sun;
-  glm::vec3 e = capture.hidden->indirect[hit.surface];
-  const float cos_sun = glm::dot(hit.normal, sun.dir);
-  if (sun.above_horizon && cos_sun > 0.0f && !capture.caster->Occluded(y + 2e-3f * hit.normal, sun.dir)) {
-    e += sun.dni_rgb * cos_sun;
-  }
+  const glm::vec3 e = capture.hidden->indirect[hit.surface] + DirectSun(capture, y + 2e-3f * hit.normal, hit.normal);
   return capture.hidden->albedo[hit.surface] * glm::one_over_pi<float>() * e;
 }
 
@@ -56,7 +59,6 @@ void IntegrateCaptureIrradiance(const CaptureScene& capture, const RayOptions& o
                                 glm::vec3* direct, Progress* progress) {
   const std::vector<glm::vec3> hemisphere = CosineHemisphere(options.hemisphere_rays);
   const float inv_rays = 1.0f / static_cast<float>(hemisphere.size());
-  const CaptureSun& sun = capture.sun;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kGrain), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
       const glm::vec3 origin = points[i] + options.offset_m * normals[i];
@@ -73,9 +75,7 @@ void IntegrateCaptureIrradiance(const CaptureScene& capture, const RayOptions& o
           sum += RadianceAt(capture, origin + hit.t * dir, hit);
         }
       }
-      glm::vec3 sun_part(0.0f);
-      const float cos_sun = glm::dot(normals[i], sun.dir);
-      if (sun.above_horizon && cos_sun > 0.0f && !capture.caster->Occluded(origin, sun.dir)) sun_part = sun.dni_rgb * cos_sun;
+      const glm::vec3 sun_part = DirectSun(capture, origin, normals[i]);
       sky_visibility[i] = static_cast<float>(sky) * inv_rays;
       irradiance[i] = glm::pi<float>() * inv_rays * sum + sun_part;
       if (direct != nullptr) direct[i] = sun_part;

@@ -22,8 +22,7 @@ struct BakeCommandOptions {
 
 void RunBakeCommand(const BakeCommandOptions& o) {
   const scene::Scene scene = scene::LoadScene(o.recording);
-  const std::filesystem::path dir =
-      bake::CacheDir(scene, o.cache.empty() ? std::nullopt : std::optional<std::filesystem::path>(o.cache));
+  const std::filesystem::path dir = bake::CacheDir(scene, o.cache);
   const auto start = std::chrono::steady_clock::now();
   bool loaded = false;
   bake::SceneBake baked;

@@ -23,8 +23,7 @@ struct EstimateCommandOptions {
 
 void RunEstimateCommand(const EstimateCommandOptions& o) {
   const scene::Scene scene = scene::LoadScene(o.recording);
-  const std::filesystem::path dir =
-      bake::CacheDir(scene, o.cache.empty() ? std::nullopt : std::optional<std::filesystem::path>(o.cache));
+  const std::filesystem::path dir = bake::CacheDir(scene, o.cache);
   bool loaded = false;
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, dir, &loaded);
   Log().info("{} the bake: {}", loaded ? "loaded" : "made", dir.string());
