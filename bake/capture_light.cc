@@ -12,6 +12,26 @@
 namespace daylit::bake {
 namespace {
 
+// Entries without data take the value of the nearest entry with data (linear between two).
+void FillFromNearest(std::vector<glm::dvec3>* values, const std::vector<uint8_t>& known) {
+  const int n = static_cast<int>(values->size());
+  for (int i = 0; i < n; ++i) {
+    if (known[static_cast<size_t>(i)]) continue;
+    int lo = i - 1, hi = i + 1;
+    while (lo >= 0 && !known[static_cast<size_t>(lo)]) --lo;
+    while (hi < n && !known[static_cast<size_t>(hi)]) ++hi;
+    if (lo < 0 && hi >= n) return;
+    if (lo < 0) {
+      (*values)[static_cast<size_t>(i)] = (*values)[static_cast<size_t>(hi)];
+    } else if (hi >= n) {
+      (*values)[static_cast<size_t>(i)] = (*values)[static_cast<size_t>(lo)];
+    } else {
+      const double f = static_cast<double>(i - lo) / (hi - lo);
+      (*values)[static_cast<size_t>(i)] = (1.0 - f) * (*values)[static_cast<size_t>(lo)] + f * (*values)[static_cast<size_t>(hi)];
+    }
+  }
+}
+
 float Luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
 
 }  // namespace
@@ -77,16 +97,17 @@ CaptureSun ExtractSun(scene::HdrImage* env, const glm::dvec3& sun_dir, const std
   return sun;
 }
 
-scene::HdrImage SkyOnly(const scene::HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir) {
-  constexpr int kThetaBins = 181;  // 1° from the zenith to the nadir
-  constexpr int kGammaBins = 90;   // 2° from the sun to its opposite
-  const auto bin_of = [&](const glm::dvec3& d) {
-    const double theta = glm::degrees(std::acos(std::clamp(d.z, -1.0, 1.0)));
-    const double gamma = glm::degrees(std::acos(std::clamp(glm::dot(d, glm::dvec3(sun_dir)), -1.0, 1.0)));
-    const int ti = std::min(kThetaBins - 1, static_cast<int>(theta));
-    const int gi = std::min(kGammaBins - 1, static_cast<int>(gamma / 2.0));
-    return static_cast<size_t>(ti) * kGammaBins + static_cast<size_t>(gi);
-  };
+size_t SkyDistribution::BinOf(const glm::vec3& dir, const glm::vec3& sun_dir) {
+  const glm::dvec3 d(dir);
+  const double theta = glm::degrees(std::acos(std::clamp(d.z, -1.0, 1.0)));
+  const double gamma = glm::degrees(std::acos(std::clamp(glm::dot(d, glm::dvec3(sun_dir)), -1.0, 1.0)));
+  const int ti = std::min(kThetaBins - 1, static_cast<int>(theta));
+  const int gi = std::min(kGammaBins - 1, static_cast<int>(gamma / 2.0));
+  return static_cast<size_t>(ti) * kGammaBins + static_cast<size_t>(gi);
+}
+
+SkyDistribution::SkyDistribution(const scene::HdrImage& env, const std::vector<uint8_t>& is_sky,
+                                 const glm::vec3& sun_dir) {
   std::vector<glm::dvec3> sum(kThetaBins * kGammaBins, glm::dvec3(0.0));
   std::vector<double> weight(sum.size(), 0.0);
   for (int v = 0; v < env.height; ++v) {
@@ -94,16 +115,18 @@ scene::HdrImage SkyOnly(const scene::HdrImage& env, const std::vector<uint8_t>& 
     for (int u = 0; u < env.width; ++u) {
       if (!is_sky[static_cast<size_t>(v) * env.width + u]) continue;
       const float* p = env.Pixel(u, v);
-      const size_t b = bin_of(scene::LatLongDirection(u, v, env.width, env.height));
+      const size_t b = BinOf(glm::vec3(scene::LatLongDirection(u, v, env.width, env.height)), sun_dir);
       sum[b] += solid_angle * glm::dvec3(p[0], p[1], p[2]);
       weight[b] += solid_angle;
     }
   }
-  // Empty bins (directions the capture point never sees as sky, such as the low sky behind the
-  // buildings) get a harmonic fill in log radiance: each is the mean of its four neighbours,
-  // iterated to convergence, so holes blend between the known sky on every side. Copying the
-  // nearest filled bin instead carried the bright aureole 40° away into the dim sky at 90° from
-  // the sun and made shaded walls too warm.
+  // Bins the capture never saw as sky (the low sky behind the buildings; for another sun, the
+  // (θ, γ) pairs that sun makes and the capture's did not) come from a separable fit
+  // L ≈ g(θ)·h(γ), the form of the Perez and CIE standard skies (gradation × indicatrix), fitted
+  // to the seen bins in log radiance. Copying the nearest seen bin instead carried the bright
+  // aureole 40° away into the dim sky at 90° from the sun and made shaded walls too warm; a
+  // harmonic fill across the (θ, γ) plane underestimated the zenith for a sun far from the
+  // capture's.
   std::vector<glm::vec3> log_mean(sum.size(), glm::vec3(0.0f));
   std::vector<uint8_t> known(sum.size(), 0);
   bool any = false;
@@ -113,34 +136,72 @@ scene::HdrImage SkyOnly(const scene::HdrImage& env, const std::vector<uint8_t>& 
     known[b] = 1;
     any = true;
   }
-  if (!any) return env;  // no sky at all: nothing to fill from
-  glm::vec3 known_mean(0.0f);
-  float known_count = 0.0f;
-  for (size_t b = 0; b < sum.size(); ++b) known_mean += known[b] ? log_mean[b] : glm::vec3(0.0f), known_count += known[b];
-  for (size_t b = 0; b < sum.size(); ++b) {
-    if (!known[b]) log_mean[b] = known_mean / known_count;
-  }
-  const auto at = [&](int t, int g) { return log_mean[static_cast<size_t>(std::clamp(t, 0, kThetaBins - 1)) * kGammaBins + static_cast<size_t>(std::clamp(g, 0, kGammaBins - 1))]; };
-  for (int iteration = 0; iteration < 2000; ++iteration) {
-    float change = 0.0f;
+  if (!any) return;  // no sky at all: nothing to fit
+  std::vector<glm::dvec3> log_g(kThetaBins, glm::dvec3(0.0)), log_h(kGammaBins, glm::dvec3(0.0));
+  std::vector<uint8_t> g_known(kThetaBins, 0), h_known(kGammaBins, 0);
+  const auto index = [](int t, int g) { return static_cast<size_t>(t) * kGammaBins + static_cast<size_t>(g); };
+  constexpr int kHorizon = 90;  // the indicatrix h is fitted on the upper hemisphere only
+  for (int iteration = 0; iteration < 30; ++iteration) {
     for (int t = 0; t < kThetaBins; ++t) {
+      glm::dvec3 num(0.0);
+      double den = 0.0;
       for (int g = 0; g < kGammaBins; ++g) {
-        const size_t b = static_cast<size_t>(t) * kGammaBins + static_cast<size_t>(g);
-        if (known[b]) continue;
-        const glm::vec3 next = 0.25f * (at(t - 1, g) + at(t + 1, g) + at(t, g - 1) + at(t, g + 1));
-        change = std::max(change, glm::compMax(glm::abs(next - log_mean[b])));
-        log_mean[b] = next;
+        const size_t b = index(t, g);
+        if (known[b]) num += weight[b] * (glm::dvec3(log_mean[b]) - log_h[static_cast<size_t>(g)]), den += weight[b];
       }
+      if (den > 0.0) log_g[static_cast<size_t>(t)] = num / den, g_known[static_cast<size_t>(t)] = 1;
     }
-    if (change < 1e-4f) break;
+    for (int g = 0; g < kGammaBins; ++g) {
+      glm::dvec3 num(0.0);
+      double den = 0.0;
+      for (int t = 0; t < kHorizon; ++t) {
+        const size_t b = index(t, g);
+        if (known[b]) num += weight[b] * (glm::dvec3(log_mean[b]) - log_g[static_cast<size_t>(t)]), den += weight[b];
+      }
+      if (den > 0.0) log_h[static_cast<size_t>(g)] = num / den, h_known[static_cast<size_t>(g)] = 1;
+    }
   }
-  std::vector<glm::vec3> mean(sum.size());
-  for (size_t b = 0; b < sum.size(); ++b) mean[b] = known[b] ? glm::vec3(sum[b] / weight[b]) : glm::exp(log_mean[b]);
+  FillFromNearest(&log_g, g_known);
+  FillFromNearest(&log_h, h_known);
+  mean_.resize(sum.size());
+  for (int t = 0; t < kThetaBins; ++t) {
+    for (int g = 0; g < kGammaBins; ++g) {
+      const size_t b = index(t, g);
+      mean_[b] = known[b] ? glm::vec3(sum[b] / weight[b])
+                          : glm::vec3(glm::exp(log_g[static_cast<size_t>(t)] + log_h[static_cast<size_t>(g)]));
+    }
+  }
+}
+
+glm::vec3 SkyDistribution::Radiance(const glm::vec3& dir, const glm::vec3& sun_dir) const {
+  return mean_.empty() ? glm::vec3(0.0f) : mean_[BinOf(dir, sun_dir)];
+}
+
+glm::dvec3 SkyDistribution::HorizontalIrradiance(const glm::vec3& sun_dir) const {
+  // Midpoint rule on a 0.5° × 1° grid of the upper hemisphere: finer than the bins.
+  constexpr int kRows = 180, kColumns = 360;
+  glm::dvec3 sum(0.0);
+  for (int r = 0; r < kRows; ++r) {
+    const double theta = 0.5 * glm::pi<double>() * (r + 0.5) / kRows;
+    const double weight = std::cos(theta) * std::sin(theta) * (0.5 * glm::pi<double>() / kRows) *
+                          (2.0 * glm::pi<double>() / kColumns);
+    for (int c = 0; c < kColumns; ++c) {
+      const double phi = 2.0 * glm::pi<double>() * (c + 0.5) / kColumns;
+      const glm::vec3 dir(glm::dvec3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)));
+      sum += weight * glm::dvec3(Radiance(dir, sun_dir));
+    }
+  }
+  return sum;
+}
+
+scene::HdrImage SkyOnly(const scene::HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir) {
+  const SkyDistribution distribution(env, is_sky, sun_dir);
+  if (distribution.empty()) return env;
   scene::HdrImage sky = env;
   for (int v = 0; v < env.height; ++v) {
     for (int u = 0; u < env.width; ++u) {
       if (is_sky[static_cast<size_t>(v) * env.width + u]) continue;
-      const glm::vec3 m = mean[bin_of(scene::LatLongDirection(u, v, env.width, env.height))];
+      const glm::vec3 m = distribution.Radiance(glm::vec3(scene::LatLongDirection(u, v, env.width, env.height)), sun_dir);
       float* p = sky.Pixel(u, v);
       p[0] = m.x, p[1] = m.y, p[2] = m.z;
     }

@@ -62,4 +62,11 @@ float RotationOf(uint32_t key) {
   return static_cast<float>(key) * 2.3283064365386963e-10f * 2.0f * glm::pi<float>();
 }
 
+glm::mat3 HemisphereFrame(const glm::vec3& n, uint32_t key) {
+  const float angle = RotationOf(key);
+  const float c = std::cos(angle), s = std::sin(angle);
+  const glm::mat3 spin(glm::vec3(c, s, 0.0f), glm::vec3(-s, c, 0.0f), glm::vec3(0.0f, 0.0f, 1.0f));
+  return BasisAround(n) * spin;
+}
+
 }  // namespace daylit::bake

@@ -1,6 +1,7 @@
 // Deterministic ray directions for integrals over hemispheres and spheres.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -22,5 +23,9 @@ std::vector<glm::vec3> SphericalFibonacci(int count);
 // A rotation angle in [0, 2π) from an integer key (hash), to decorrelate the sample patterns of
 // neighbouring points (Cranley-Patterson rotation about the normal).
 float RotationOf(uint32_t key);
+
+// BasisAround(n) turned about n by RotationOf(key): the frame that carries a CosineHemisphere
+// pattern to the point with unit normal `n` and index `key`.
+glm::mat3 HemisphereFrame(const glm::vec3& n, uint32_t key);
 
 }  // namespace daylit::bake

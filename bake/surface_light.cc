@@ -15,14 +15,6 @@ namespace {
 
 constexpr size_t kGrain = 64;  // points per task
 
-// The hemisphere pattern turned to the normal and rotated about it by a per-point angle.
-glm::mat3 FrameFor(const glm::vec3& normal, size_t index) {
-  const float angle = RotationOf(static_cast<uint32_t>(index));
-  const float c = std::cos(angle), s = std::sin(angle);
-  const glm::mat3 spin(glm::vec3(c, s, 0.0f), glm::vec3(-s, c, 0.0f), glm::vec3(0.0f, 0.0f, 1.0f));
-  return BasisAround(normal) * spin;
-}
-
 // E_sun·s·max(0, n·l) at a point with unit normal `normal`, the shadow ray leaving from
 // `origin` (the point, already moved off its surface).
 glm::vec3 DirectSun(const CaptureScene& capture, const glm::vec3& origin, const glm::vec3& normal) {
@@ -38,21 +30,28 @@ glm::vec3 RadianceAt(const CaptureScene& capture, const glm::vec3& y, const scen
   const int texel = scene::LatLongTexel(glm::dvec3(toward), capture.env->width, capture.env->height);
   const glm::vec3 texel_radiance = TexelRadiance(*capture.env, texel);
   if (capture.hidden == nullptr || capture.env_distance == nullptr) return texel_radiance;
-  // The capture point sees y unless its own ray toward y stops clearly short of it. The texel's
-  // ray can be up to a texel off y's direction; on y's own surface seen at a grazing angle that
-  // moves its hit along the surface by distance·angle / cos, so the slack grows with obliquity.
-  const float distance = glm::length(toward);
-  const float seen = (*capture.env_distance)[static_cast<size_t>(texel)];
-  const float texel_angle = 2.0f * glm::pi<float>() / static_cast<float>(capture.env->height);
-  const bool same_surface = (*capture.env_surface)[static_cast<size_t>(texel)] == hit.surface;
-  const float obliquity = std::max(0.05f, std::abs(glm::dot(hit.normal, toward / distance)));
-  const float slack = 0.05f + distance * texel_angle * (same_surface ? 2.0f / obliquity : 2.0f);
-  if (seen >= 0.0f && seen >= distance - slack) return texel_radiance;
+  if (CaptureSees(toward, hit.normal, hit.surface, (*capture.env_distance)[static_cast<size_t>(texel)],
+                  (*capture.env_surface)[static_cast<size_t>(texel)], capture.env->height)) {
+    return texel_radiance;
+  }
   const glm::vec3 e = capture.hidden->indirect[hit.surface] + DirectSun(capture, y + 2e-3f * hit.normal, hit.normal);
   return capture.hidden->albedo[hit.surface] * glm::one_over_pi<float>() * e;
 }
 
 }  // namespace
+
+bool CaptureSees(const glm::vec3& toward, const glm::vec3& normal, uint32_t surface, float seen_distance,
+                 uint32_t seen_surface, int env_height) {
+  // The capture point sees y unless its own ray toward y stops clearly short of it. The texel's
+  // ray can be up to a texel off y's direction; on y's own surface seen at a grazing angle that
+  // moves its hit along the surface by distance·angle / cos, so the slack grows with obliquity.
+  const float distance = glm::length(toward);
+  const float texel_angle = 2.0f * glm::pi<float>() / static_cast<float>(env_height);
+  const bool same_surface = seen_surface == surface;
+  const float obliquity = std::max(0.05f, std::abs(glm::dot(normal, toward / distance)));
+  const float slack = 0.05f + distance * texel_angle * (same_surface ? 2.0f / obliquity : 2.0f);
+  return seen_distance >= 0.0f && seen_distance >= distance - slack;
+}
 
 void IntegrateCaptureIrradiance(const CaptureScene& capture, const RayOptions& options, const glm::vec3* points,
                                 const glm::vec3* normals, size_t count, float* sky_visibility, glm::vec3* irradiance,
@@ -62,7 +61,7 @@ void IntegrateCaptureIrradiance(const CaptureScene& capture, const RayOptions& o
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kGrain), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
       const glm::vec3 origin = points[i] + options.offset_m * normals[i];
-      const glm::mat3 frame = FrameFor(normals[i], i);
+      const glm::mat3 frame = HemisphereFrame(normals[i], static_cast<uint32_t>(i));
       glm::vec3 sum(0.0f);
       int sky = 0;
       for (const glm::vec3& local : hemisphere) {
@@ -90,7 +89,7 @@ void SkyVisibility(const scene::RayCaster& caster, const RayOptions& options, co
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kGrain), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
       const glm::vec3 origin = points[i] + options.offset_m * normals[i];
-      const glm::mat3 frame = FrameFor(normals[i], i);
+      const glm::mat3 frame = HemisphereFrame(normals[i], static_cast<uint32_t>(i));
       int sky = 0;
       for (const glm::vec3& local : hemisphere) sky += caster.Occluded(origin, frame * local) ? 0 : 1;
       sky_visibility[i] = static_cast<float>(sky) / static_cast<float>(hemisphere.size());

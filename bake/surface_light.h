@@ -40,6 +40,12 @@ struct CaptureScene {
   CaptureSun sun;
 };
 
+// Whether the capture point sees model point y (on `surface`, unit `normal`, at `toward` = y −
+// capture position) in the env texel toward it, whose own ray hits `seen_surface` at
+// `seen_distance` (< 0: sky), in a map `env_height` texels high.
+bool CaptureSees(const glm::vec3& toward, const glm::vec3& normal, uint32_t surface, float seen_distance,
+                 uint32_t seen_surface, int env_height);
+
 // For each point (unit normal facing its visible side): V = share of cosine-weighted rays that
 // reach the sky, and E = E_sun·s·max(0, n·l) + π·mean(L_in), where L_in is the sky's radiance
 // for rays that escape and, for rays that hit the model at y, y's radiance in the env map (the

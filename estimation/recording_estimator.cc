@@ -64,7 +64,8 @@ class FrameReader {
 EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& bake, const EstimateOptions& options) {
   if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames to estimate", scene.file.string());
   const scene::RayCaster caster(scene.model);
-  Sampler sampler(bake.camera, caster, options.sampler);
+  const glm::vec3 capture = scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f);
+  Sampler sampler(bake, capture, caster, options.sampler);
   TemporalFilter filter(options.filter);
   FrameReader reader(scene);
   const sunmodel::Atmosphere atmosphere = sunmodel::Atmosphere::Standard(scene.location.elevation_m);

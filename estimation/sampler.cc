@@ -1,6 +1,7 @@
 #include "estimation/sampler.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <numeric>
 #include <random>
@@ -11,8 +12,11 @@
 
 namespace daylit::estimation {
 
-Sampler::Sampler(const bake::CameraGBuffer& gbuffer, const scene::RayCaster& caster, SamplerOptions options)
-    : gbuffer_(gbuffer), caster_(caster), options_(options) {
+Sampler::Sampler(const bake::SceneBake& bake, const glm::vec3& capture_position, const scene::RayCaster& caster,
+                 SamplerOptions options)
+    : gbuffer_(bake.camera), caster_(caster), options_(options),
+      transfer_(bake, capture_position, caster, options.transfer) {
+  const bake::CameraGBuffer& gbuffer = bake.camera;
   for (size_t i = 0; i < gbuffer.diffuse.size(); ++i) {
     if (gbuffer.diffuse[i]) diffuse_pixels_.push_back(static_cast<uint32_t>(i));
   }
@@ -72,15 +76,31 @@ bool Sampler::SetSun(const glm::vec3& sun_dir) {
   }
   // Strata: (surface, sunlit?) in the shuffled order.
   std::map<std::pair<uint32_t, int>, size_t> index;
-  strata_.clear();
+  std::vector<std::vector<uint32_t>> strata;
   for (const uint32_t i : diffuse_pixels_) {
     const bool boundary = near.at<uint8_t>(static_cast<int>(i) / w, static_cast<int>(i) % w) != 0;
     near_boundary_[i] = boundary ? 1 : 0;
     if (boundary) continue;
     const auto key = std::make_pair(gbuffer_.surface[i], static_cast<int>(sunlit_[i]));
-    auto [it, inserted] = index.emplace(key, strata_.size());
-    if (inserted) strata_.emplace_back();
-    strata_[it->second].push_back(i);
+    auto [it, inserted] = index.emplace(key, strata.size());
+    if (inserted) strata.emplace_back();
+    strata[it->second].push_back(i);
+  }
+  // Each stratum's pool: the first pixels of its list, with their transfer under this sun.
+  const size_t pool = strata.empty() ? 0
+                                     : static_cast<size_t>(std::ceil(options_.pool * options_.samples /
+                                                                     static_cast<double>(strata.size()))) + 1;
+  std::vector<uint32_t> pooled;
+  for (std::vector<uint32_t>& stratum : strata) {
+    stratum.resize(std::min(stratum.size(), pool));
+    pooled.insert(pooled.end(), stratum.begin(), stratum.end());
+  }
+  std::vector<Transfer> transfer(pooled.size());
+  transfer_.Compute(pooled, sun_dir, sun_term_.data(), transfer.data());
+  strata_.assign(strata.size(), {});
+  size_t k = 0;
+  for (size_t s = 0; s < strata.size(); ++s) {
+    for (const uint32_t i : strata[s]) strata_[s].push_back({i, transfer[k++]});
   }
   return true;
 }
@@ -91,10 +111,10 @@ std::vector<Sample> Sampler::Draw(const cv::Mat& linear, double exposure) const 
   samples.reserve(static_cast<size_t>(options_.samples));
   const size_t quota = static_cast<size_t>(options_.samples) / strata_.size() + 1;
   const float inv_exposure = static_cast<float>(1.0 / exposure);
-  for (const std::vector<uint32_t>& stratum : strata_) {
+  for (const std::vector<Candidate>& stratum : strata_) {
     size_t taken = 0;
     for (size_t k = 0; k < stratum.size() && taken < quota; ++k) {
-      const uint32_t i = stratum[k];
+      const uint32_t i = stratum[k].pixel;
       const cv::Vec3f& p = linear.at<cv::Vec3f>(static_cast<int>(i / gbuffer_.width), static_cast<int>(i % gbuffer_.width));
       bool usable = true;
       for (int c = 0; c < 3; ++c) usable = usable && p[c] < options_.saturated && p[c] > options_.near_black;
@@ -102,8 +122,10 @@ std::vector<Sample> Sampler::Draw(const cv::Mat& linear, double exposure) const 
       Sample s;
       s.radiance = glm::vec3(p[0], p[1], p[2]) * inv_exposure;
       s.albedo = gbuffer_.albedo[i];
-      s.sun = sun_term_[i];
-      s.sky = gbuffer_.sky_visibility[i];
+      s.sun = stratum[k].transfer.sun;
+      s.sky = stratum[k].transfer.clear;
+      s.overcast = stratum[k].transfer.overcast;
+      s.sunlit = sunlit_[i] != 0;
       samples.push_back(s);
       ++taken;
     }

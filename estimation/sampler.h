@@ -2,7 +2,8 @@
 // shadowed areas (the two strata are what separates E_sun from E_sky), skipping pixels near a
 // shadow edge or a silhouette of the model (misregistration there is the main error source) and,
 // per frame, saturated and near-black pixels. The sun visibility behind the strata is re-cast only when the
-// sun has moved more than `recast_angle_deg`.
+// sun has moved more than `recast_angle_deg`; so are the transfer terms (estimation/transfer.h) of the
+// pixels each stratum may use.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +15,7 @@
 
 #include "bake/bake.h"
 #include "estimation/sun_sky_fit.h"
+#include "estimation/transfer.h"
 #include "scene/raycaster.h"
 
 namespace daylit::estimation {
@@ -24,11 +26,16 @@ struct SamplerOptions {
   double recast_angle_deg = 0.05;    // re-cast sun visibility when the sun moved more than this
   double saturated = 0.98;           // linear pixel value (before exposure) treated as clipped
   double near_black = 0.002;         // linear pixel value below which noise dominates
+  double pool = 1.5;                 // pixels per stratum given transfer terms, in units of its quota
+                                     // (room for pixels a frame skips as clipped or black)
+  TransferOptions transfer;
 };
 
 class Sampler {
  public:
-  Sampler(const bake::CameraGBuffer& gbuffer, const scene::RayCaster& caster, SamplerOptions options = {});
+  // `capture_position`: scene.envmap.position. `bake` and `caster` must outlive the sampler.
+  Sampler(const bake::SceneBake& bake, const glm::vec3& capture_position, const scene::RayCaster& caster,
+          SamplerOptions options = {});
 
   // Updates the strata for the sun direction `sun_dir` (unit, scene coordinates; z ≤ 0: night,
   // everything is shadowed). Cheap when the sun has not moved enough. Returns true if it re-cast.
@@ -51,7 +58,12 @@ class Sampler {
   std::optional<glm::vec3> sun_;
   std::vector<uint8_t> sunlit_, near_boundary_;
   std::vector<float> sun_term_;  // s·max(0, n·l) per pixel
-  std::vector<std::vector<uint32_t>> strata_;  // pixel lists, each in the shuffled order
+  CameraTransfer transfer_;
+  struct Candidate {
+    uint32_t pixel;
+    Transfer transfer;
+  };
+  std::vector<std::vector<Candidate>> strata_;  // the pool of each stratum, in the shuffled order
 };
 
 }  // namespace daylit::estimation

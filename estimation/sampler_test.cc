@@ -27,6 +27,15 @@ struct WallScene {
     caster = std::make_unique<scene::RayCaster>(scene.model);
   }
 
+  // The model of seed 001 (no interreflection, a uniform sky): what Render draws.
+  static SamplerOptions SeedModel() {
+    SamplerOptions options;
+    options.transfer.interreflection = false;
+    options.transfer.sky_distribution = false;
+    return options;
+  }
+  glm::vec3 Capture() const { return glm::vec3(scene.envmap->position); }
+
   // The frame the model predicts for `light`, as linear RGB floats times `exposure`.
   cv::Mat Render(const Sampler& sampler, const SunSky& light, double exposure) const {
     const bake::CameraGBuffer& g = bake.camera;
@@ -44,7 +53,7 @@ struct WallScene {
 
 TEST(SamplerTest, ExactSyntheticFrameIsRecoveredTo0_1Percent) {
   const WallScene w;
-  Sampler sampler(w.bake.camera, *w.caster);
+  Sampler sampler(w.bake, w.Capture(), *w.caster, WallScene::SeedModel());
   ASSERT_TRUE(sampler.SetSun(w.sun));
   EXPECT_EQ(sampler.StratumCount(), 2u);  // ground sunlit, ground shadowed
   const SunSky light{{86.0, 63.0, 37.0}, {9.9, 9.7, 10.0}};
@@ -61,7 +70,7 @@ TEST(SamplerTest, ExactSyntheticFrameIsRecoveredTo0_1Percent) {
 
 TEST(SamplerTest, ShadowEdgesClippedAndDarkPixelsAreLeftOut) {
   const WallScene w;
-  Sampler sampler(w.bake.camera, *w.caster);
+  Sampler sampler(w.bake, w.Capture(), *w.caster, WallScene::SeedModel());
   sampler.SetSun(w.sun);
   // The shadow edge at x = -2 runs across the image, and the wall's silhouette from x = 1 (its foot)
   // to x = 2.5 (where its top hides the ground): only ground near those is excluded (3 px at
@@ -89,7 +98,7 @@ TEST(SamplerTest, ShadowEdgesClippedAndDarkPixelsAreLeftOut) {
 
 TEST(SamplerTest, SunVisibilityIsRecastOnlyWhenTheSunMoves) {
   const WallScene w;
-  Sampler sampler(w.bake.camera, *w.caster);
+  Sampler sampler(w.bake, w.Capture(), *w.caster, WallScene::SeedModel());
   EXPECT_TRUE(sampler.SetSun(w.sun));
   const glm::vec3 tiny = glm::normalize(w.sun + glm::vec3(0.0f, 0.0005f, 0.0f));  // 0.02°
   EXPECT_FALSE(sampler.SetSun(tiny));

@@ -3,48 +3,89 @@
 #include "base/statistics.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include <fmt/format.h>
 #include <glm/gtc/constants.hpp>
+#include <glm/gtx/component_wise.hpp>
 
 namespace daylit::estimation {
 namespace {
 
 constexpr int kMinSamples = 10;
 
-double Median(std::vector<double> v) { return MedianInPlace(v, 0.0); }
+bool IsSunlit(const Sample& s, const SunSkyFitOptions& options) {
+  return s.sunlit && glm::compMin(s.sun) > options.sunlit_threshold;
+}
 
-struct ChannelFit {
-  double sun = 0.0, sky = 0.0;
-};
+// E_sun, E_clear, E_overcast of one channel.
+using ChannelFit = std::array<double, 3>;
 
-// Weighted least squares for y ≈ u·E_sun + v·E_sky with E ≥ 0 (two unknowns: the unconstrained
-// solution if it is feasible, else the better of the two one-variable solutions).
-ChannelFit SolveNonNegative(const std::vector<double>& y, const std::vector<double>& u, const std::vector<double>& v,
-                            const std::vector<double>& w, bool with_sun) {
-  double suu = 0, suv = 0, svv = 0, suy = 0, svy = 0;
+// Weighted least squares for y ≈ Σ_j x_j·E_j, E ≥ 0, over the unknowns in `free` (the others stay
+// 0): every subset of them is solved from the normal equations and the best feasible one wins
+// (three unknowns at most: seven subsets, each a 3×3 solve, no pass over the data).
+ChannelFit SolveNonNegative(const std::vector<double>& y, const std::array<std::vector<double>, 3>& x,
+                            const std::vector<double>& w, const std::array<bool, 3>& free) {
+  std::array<std::array<double, 3>, 3> a{};
+  std::array<double, 3> b{};
+  double yy = 0.0;
   for (size_t i = 0; i < y.size(); ++i) {
-    suu += w[i] * u[i] * u[i], suv += w[i] * u[i] * v[i], svv += w[i] * v[i] * v[i];
-    suy += w[i] * u[i] * y[i], svy += w[i] * v[i] * y[i];
-  }
-  const auto cost = [&](double sun, double sky) {
-    double c = 0.0;
-    for (size_t i = 0; i < y.size(); ++i) {
-      const double r = y[i] - u[i] * sun - v[i] * sky;
-      c += w[i] * r * r;
+    yy += w[i] * y[i] * y[i];
+    for (size_t j = 0; j < 3; ++j) {
+      if (!free[j]) continue;
+      b[j] += w[i] * x[j][i] * y[i];
+      for (size_t k = j; k < 3; ++k) a[j][k] += free[k] ? w[i] * x[j][i] * x[k][i] : 0.0;
     }
-    return c;
-  };
-  const double det = suu * svv - suv * suv;
-  if (with_sun && det > 1e-12 * suu * svv) {
-    const ChannelFit free{(svv * suy - suv * svy) / det, (suu * svy - suv * suy) / det};
-    if (free.sun >= 0.0 && free.sky >= 0.0) return free;
   }
-  const ChannelFit sky_only{0.0, svv > 0.0 ? std::max(0.0, svy / svv) : 0.0};
-  if (!with_sun) return sky_only;
-  const ChannelFit sun_only{suu > 0.0 ? std::max(0.0, suy / suu) : 0.0, 0.0};
-  return cost(sky_only.sun, sky_only.sky) <= cost(sun_only.sun, sun_only.sky) ? sky_only : sun_only;
+  for (size_t j = 0; j < 3; ++j) {
+    for (size_t k = 0; k < j; ++k) a[j][k] = a[k][j];
+  }
+  ChannelFit best{0.0, 0.0, 0.0};
+  double best_cost = yy;
+  for (unsigned mask = 1; mask < 8; ++mask) {
+    std::array<size_t, 3> idx{};
+    size_t m = 0;
+    bool allowed = true;
+    for (size_t j = 0; j < 3; ++j) {
+      if (mask & (1u << j)) allowed = allowed && free[j], idx[m++] = j;
+    }
+    if (!allowed) continue;
+    // Solve the m×m system by Gaussian elimination with partial pivoting.
+    std::array<std::array<double, 4>, 3> g{};
+    for (size_t r = 0; r < m; ++r) {
+      for (size_t c = 0; c < m; ++c) g[r][c] = a[idx[r]][idx[c]];
+      g[r][3] = b[idx[r]];
+    }
+    bool singular = false;
+    for (size_t c = 0; c < m && !singular; ++c) {
+      size_t pivot = c;
+      for (size_t r = c + 1; r < m; ++r) pivot = std::abs(g[r][c]) > std::abs(g[pivot][c]) ? r : pivot;
+      std::swap(g[c], g[pivot]);
+      if (!(std::abs(g[c][c]) > 1e-12 * std::abs(a[idx[c]][idx[c]]) && g[c][c] != 0.0)) {
+        singular = true;
+        break;
+      }
+      for (size_t r = 0; r < m; ++r) {
+        if (r == c) continue;
+        const double f = g[r][c] / g[c][c];
+        for (size_t k = c; k < 4; ++k) g[r][k] -= f * g[c][k];
+      }
+    }
+    if (singular) continue;
+    ChannelFit e{0.0, 0.0, 0.0};
+    bool feasible = true;
+    for (size_t r = 0; r < m; ++r) e[idx[r]] = g[r][3] / g[r][r], feasible = feasible && e[idx[r]] >= 0.0;
+    if (!feasible) continue;
+    // cost = yᵀWy − 2 eᵀb + eᵀA e
+    double cost = yy;
+    for (size_t j = 0; j < 3; ++j) {
+      cost -= 2.0 * e[j] * b[j];
+      for (size_t k = 0; k < 3; ++k) cost += e[j] * a[j][k] * e[k];
+    }
+    if (cost < best_cost) best_cost = cost, best = e;
+  }
+  return best;
 }
 
 }  // namespace
@@ -65,10 +106,10 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   std::vector<size_t> usable;
   for (size_t i = 0; i < samples.size(); ++i) {
     const Sample& s = samples[i];
-    if (s.sky > 0.0f || s.sun > 0.0f) usable.push_back(i);
-    if (s.sun > options.sunlit_threshold) {
+    if (glm::compMax(s.sky) > 0.0f || glm::compMax(s.sun) > 0.0f) usable.push_back(i);
+    if (IsSunlit(s, options)) {
       ++summary.sunlit_samples;
-    } else if (s.sun <= 0.0f) {
+    } else if (!s.sunlit) {
       ++summary.shadowed_samples;
     }
   }
@@ -81,46 +122,81 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   std::vector<double> spreads;
   std::vector<double> all_residuals;
   all_residuals.reserve(3 * n);
-  for (int c = 0; c < 3; ++c) {
-    std::vector<double> y(n), u(n), v(n), w(n, 1.0);
+  // Two skies (clear-shaped and overcast) when the samples tell them apart, else one.
+  bool two_skies = options.split_sky;
+  if (two_skies) {
+    two_skies = false;
+    for (const size_t i : usable) two_skies = two_skies || samples[i].sky != samples[i].overcast;
+  }
+  std::vector<double> y(n), w(n), relative(n), scratch;
+  std::array<std::vector<double>, 3> x{std::vector<double>(n), std::vector<double>(n), std::vector<double>(n)};
+  scratch.reserve(n);
+  // One channel: E_sun and E_sky, or, with `split`, E_sun, E_clear and E_overcast; else the sky's
+  // regressor is the clear one and the overcast one mixed by `share`.
+  const auto fit_channel = [&](int c, bool split, double share) {
+    std::vector<double>&u = x[0], &v = x[1];
+    std::fill(w.begin(), w.end(), 1.0);
     for (size_t k = 0; k < n; ++k) {
       const Sample& s = samples[usable[k]];
+      const double a = s.albedo[c] * glm::one_over_pi<double>();
       y[k] = s.radiance[c];
-      u[k] = s.albedo[c] * glm::one_over_pi<double>() * s.sun;
-      v[k] = s.albedo[c] * glm::one_over_pi<double>() * s.sky;
+      u[k] = a * s.sun[c];
+      v[k] = split ? a * s.sky[c] : a * ((1.0 - share) * s.sky[c] + share * s.overcast[c]);
+      x[2][k] = split ? a * s.overcast[c] : 0.0;
     }
-    // Robust start: the sky from the shadowed samples alone, then the sun from the sunlit ones.
-    std::vector<double> sky_ratios, sun_ratios;
+    // Robust start, one sky: the sky from the shadowed samples alone, then the sun from the
+    // sunlit ones.
+    scratch.clear();
     for (size_t k = 0; k < n; ++k) {
-      if (samples[usable[k]].sun <= 0.0f && v[k] > 0.0) sky_ratios.push_back(y[k] / v[k]);
+      if (!samples[usable[k]].sunlit && v[k] > 0.0) scratch.push_back(y[k] / v[k]);
     }
-    ChannelFit fit{0.0, Median(sky_ratios)};
-    if (sky_ratios.empty()) fit = SolveNonNegative(y, u, v, w, with_sun);
+    ChannelFit fit{0.0, MedianInPlace(scratch, 0.0), 0.0};
+    if (scratch.empty()) fit = SolveNonNegative(y, x, w, {with_sun, true, false});
+    scratch.clear();
     for (size_t k = 0; k < n; ++k) {
-      if (samples[usable[k]].sun > options.sunlit_threshold) sun_ratios.push_back((y[k] - v[k] * fit.sky) / u[k]);
+      if (IsSunlit(samples[usable[k]], options)) scratch.push_back((y[k] - v[k] * fit[1]) / u[k]);
     }
-    if (with_sun && !sun_ratios.empty()) fit.sun = std::max(0.0, Median(sun_ratios));
-    // IRLS, Cauchy weights on residuals relative to the prediction (floored at a tenth of the
-    // median prediction, so near-black points do not dominate).
-    std::vector<double> relative(n);
+    if (with_sun && !scratch.empty()) fit[0] = std::max(0.0, MedianInPlace(scratch, 0.0));
+    const auto predict = [&](size_t k) { return x[0][k] * fit[0] + x[1][k] * fit[1] + x[2][k] * fit[2]; };
+    // IRLS, Cauchy weights on residuals relative to the prediction, floored at a tenth of the
+    // start's median prediction so that near-black points do not dominate.
+    scratch.resize(n);
+    for (size_t k = 0; k < n; ++k) scratch[k] = predict(k);
+    const double floor = std::max(1e-12, 0.1 * MedianInPlace(scratch, 0.0));
     for (int iteration = 0; iteration < options.iterations; ++iteration) {
-      std::vector<double> predictions(n);
-      for (size_t k = 0; k < n; ++k) predictions[k] = u[k] * fit.sun + v[k] * fit.sky;
-      const double floor = std::max(1e-12, 0.1 * Median(predictions));
       for (size_t k = 0; k < n; ++k) {
-        const double scale = std::max(predictions[k], floor);
-        relative[k] = (y[k] - predictions[k]) / scale;
+        const double prediction = predict(k);
+        const double scale = std::max(prediction, floor);
+        relative[k] = (y[k] - prediction) / scale;
         const double r = relative[k] / options.cauchy_scale;
         // Least squares on relative residuals: weight 1/scale² times the Cauchy weight.
         w[k] = 1.0 / (scale * scale * (1.0 + r * r));
       }
-      fit = SolveNonNegative(y, u, v, w, with_sun);
+      fit = SolveNonNegative(y, x, w, {with_sun, true, split});
     }
-    summary.light.sun_rgb[c] = fit.sun;
-    summary.light.sky_rgb[c] = fit.sky;
-    std::vector<double> magnitude(n);
-    for (size_t k = 0; k < n; ++k) magnitude[k] = std::abs(relative[k]), all_residuals.push_back(magnitude[k]);
-    spreads.push_back(1.4826 * Median(magnitude));
+    return fit;
+  };
+  // The overcast share of the sky is one number for all channels (clouds are grey): fitted per
+  // channel, then pooled, then each channel fitted again with it. Per-channel shares let a small
+  // model error in one channel trade sun for sky there.
+  double share = 0.0;
+  if (two_skies) {
+    glm::dvec3 clear(0.0), overcast(0.0);
+    for (int c = 0; c < 3; ++c) {
+      const ChannelFit fit = fit_channel(c, true, 0.0);
+      clear[c] = fit[1], overcast[c] = fit[2];
+    }
+    const double sky = glm::compAdd(clear + overcast);
+    share = sky > 0.0 ? glm::compAdd(overcast) / sky : 0.0;
+  }
+  summary.overcast_share = share;
+  for (int c = 0; c < 3; ++c) {
+    const ChannelFit fit = fit_channel(c, false, share);
+    summary.light.sun_rgb[c] = fit[0];
+    summary.light.sky_rgb[c] = fit[1];
+    scratch.resize(n);
+    for (size_t k = 0; k < n; ++k) scratch[k] = std::abs(relative[k]), all_residuals.push_back(scratch[k]);
+    spreads.push_back(1.4826 * MedianInPlace(scratch, 0.0));
   }
   summary.residual_spread = *std::max_element(spreads.begin(), spreads.end());
   size_t inliers = 0;

@@ -1,12 +1,15 @@
 // The per-frame fit of seed 001, per colour channel: observed radiance at sampled points of the
-// diffuse surfaces against the model of design.md,
+// diffuse surfaces against the model of design.md with its transfer terms (estimation/transfer.h),
 //
-//   y_i = ρ_i/π · (a_i · E_sun + b_i · E_sky),   a_i = s_i·max(0, n_i·l),  b_i = V_i,
+//   y_i = ρ_i/π · (T_sun,i · E_sun + T_clear,i · E_clear + T_overcast,i · E_overcast)
 //
-// for E_sun, E_sky ≥ 0. Robust: a median-based start from the shadowed and the sunlit samples,
-// then iteratively reweighted least squares with a Cauchy loss on relative residuals (albedo and
-// registration errors are multiplicative), so that a person walking through the view or a
-// misregistered shadow edge does not move the estimate.
+// (seed 001 itself: T_sun = s·max(0, n·l), T_clear = T_overcast = V), for E ≥ 0; the sky's DHI is
+// E_sky = E_clear + E_overcast. A sky between the clear one and an overcast one (a cloud passing)
+// is a mix of the two, and the two shapes light walls and shadows differently. Robust: a
+// median-based start from the shadowed and the sunlit samples, then iteratively reweighted least
+// squares with a Cauchy loss on relative residuals (albedo and registration errors are
+// multiplicative), so that a person walking through the view or a misregistered shadow edge does
+// not move the estimate.
 #pragma once
 
 #include <array>
@@ -24,17 +27,20 @@ namespace daylit::estimation {
 struct Sample {
   glm::vec3 radiance{0.0f};
   glm::vec3 albedo{0.0f};
-  float sun = 0.0f;  // a = s·max(0, n·l)
-  float sky = 0.0f;  // b = V
+  glm::vec3 sun{0.0f};  // a: irradiance per unit DNI (s·max(0, n·l) without interreflection)
+  glm::vec3 sky{0.0f};  // b: irradiance per unit DHI of a clear sky (V with a uniform sky and no interreflection)
+  glm::vec3 overcast{0.0f};  // irradiance per unit DHI of a uniform overcast sky
+  bool sunlit = false;  // s·max(0, n·l) > 0: the direct sun reaches the point
 };
 
 struct SunSkyFitOptions {
   double cauchy_scale = 0.1;        // relative residual at which a sample's weight halves
   int iterations = 12;              // IRLS iterations
-  double sunlit_threshold = 0.05;   // a above this: a sunlit sample
+  double sunlit_threshold = 0.05;   // s·max(0, n·l) above this: a sample that sees the sun well
   int min_stratum_samples = 30;     // per stratum (sunlit, shadowed) for full confidence
   double confident_residual = 0.25; // robust relative residual spread at which confidence is 1/e
                                     // (textured albedo and model gaps leave ~0.1-0.2 on real scenes)
+  bool split_sky = true;            // fit E_clear and E_overcast apart (when the samples differ)
 
   bool Check(std::string* why) const;
 };
@@ -48,6 +54,7 @@ enum class SunSkyFitStatus {
 struct SunSkyFitSummary {
   SunSkyFitStatus status = SunSkyFitStatus::kTooFewSamples;
   SunSky light;                 // E_sun (DNI) and E_sky (DHI), RGB, ≥ 0
+  double overcast_share = 0.0;  // E_overcast / E_sky (one share for all channels: clouds are grey)
   double confidence = 0.0;      // in [0, 1]
   double residual_spread = 0.0; // 1.4826·median |relative residual| over channels (robust σ)
   int sunlit_samples = 0;

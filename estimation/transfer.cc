@@ -1,0 +1,239 @@
+#include "estimation/transfer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <fmt/format.h>
+#include <glm/gtc/constants.hpp>
+#include <glm/gtx/component_wise.hpp>
+
+#include "bake/sampling.h"
+#include "bake/surface_light.h"
+#include "scene/latlong.h"
+
+namespace daylit::estimation {
+namespace {
+
+constexpr size_t kGrain = 32;  // pixels per task
+
+scene::HdrImage ImageOf(const bake::EnvMapMaps& env) {
+  scene::HdrImage image{env.width, env.height, std::vector<float>(env.radiance.size() * 3)};
+  for (size_t t = 0; t < env.radiance.size(); ++t) {
+    for (int c = 0; c < 3; ++c) image.rgb[t * 3 + static_cast<size_t>(c)] = env.radiance[t][c];
+  }
+  return image;
+}
+
+}  // namespace
+
+bool TransferOptions::Check(std::string* why) const {
+  if (rays < 8 || rays > 65536 || bounces < 1 || bounces > 8 || hidden_sky_rays < 8 || hidden_sky_rays > 65536 || !(offset_m > 0.0f && offset_m <= 0.1f)) {
+    *why = fmt::format("transfer options out of range (rays {} and hidden_sky_rays {} must be in [8, 65536], bounces "
+                       "{} in [1, 8], offset {} m in (0, 0.1])",
+                       rays, hidden_sky_rays, bounces, offset_m);
+    return false;
+  }
+  return true;
+}
+
+CameraTransfer::CameraTransfer(const bake::SceneBake& bake, const glm::vec3& capture_position,
+                               const scene::RayCaster& caster, TransferOptions options)
+    : bake_(bake), capture_position_(capture_position), caster_(caster), options_(options),
+      hemisphere_(bake::CosineHemisphere(options.rays)),
+      slot_(bake.camera.surface.size(), -1) {
+  // The captured sky's shape only means something with the sun up at capture time: the (θ, γ)
+  // table is relative to that sun.
+  if (options.sky_distribution && bake.capture_sun.above_horizon && !bake.env.radiance.empty()) {
+    std::vector<uint8_t> is_sky(bake.env.surface.size());
+    for (size_t t = 0; t < is_sky.size(); ++t) is_sky[t] = bake.env.IsSky(t) ? 1 : 0;
+    sky_ = bake::SkyDistribution(ImageOf(bake.env), is_sky, bake.capture_sun.dir);
+  }
+}
+
+void CameraTransfer::Trace(const std::vector<uint32_t>& pixels) {
+  std::vector<uint32_t> fresh;
+  for (const uint32_t p : pixels) {
+    if (slot_[p] != -1) continue;
+    slot_[p] = -2;  // listed once even if `pixels` repeats it
+    fresh.push_back(p);
+  }
+  if (fresh.empty()) return;
+  struct Local {
+    std::vector<glm::vec3> sky;
+    std::vector<Bounce> bounces;
+  };
+  std::vector<Local> local(fresh.size());
+  const bake::EnvMapMaps& env = bake_.env;
+  const bake::CameraGBuffer& g = bake_.camera;
+  const std::vector<glm::vec3> hidden_hemisphere = bake::CosineHemisphere(options_.hidden_sky_rays);
+  // Albedo and V of a bounce point: the env maps' where the capture point sees it, else the
+  // surface's median albedo and V by ray casting.
+  const auto bounce_at = [&](const glm::vec3& y, const scene::RayHit& hit) {
+    Bounce b{y + options_.offset_m * hit.normal, hit.normal, glm::vec3(0.0f), 0.0f, hit.surface, 0};
+    if (env.width > 0) {
+      const glm::vec3 toward = y - capture_position_;
+      const size_t texel = static_cast<size_t>(scene::LatLongTexel(glm::dvec3(toward), env.width, env.height));
+      const float seen = env.IsSky(texel) ? -1.0f : glm::length(env.point[texel] - capture_position_);
+      if (bake::CaptureSees(toward, hit.normal, hit.surface, seen, env.surface[texel], env.height) &&
+          glm::compMax(env.albedo[texel]) > 0.0f) {
+        b.albedo = env.albedo[texel];
+        b.sky_visibility = env.sky_visibility[texel];
+        return b;
+      }
+    }
+    b.albedo = hit.surface < bake_.albedo_table.size() ? bake_.albedo_table[hit.surface].albedo : glm::vec3(0.0f);
+    const glm::mat3 frame = bake::HemisphereFrame(hit.normal, hit.triangle);
+    int open = 0;
+    for (const glm::vec3& d : hidden_hemisphere) open += caster_.Occluded(b.point, frame * d) ? 0 : 1;
+    b.sky_visibility = static_cast<float>(open) / static_cast<float>(hidden_hemisphere.size());
+    return b;
+  };
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, fresh.size(), kGrain), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t k = range.begin(); k != range.end(); ++k) {
+      const uint32_t p = fresh[k];
+      const glm::vec3 origin = g.point[p] + options_.offset_m * g.normal[p];
+      const glm::mat3 frame = bake::HemisphereFrame(g.normal[p], p);
+      for (const glm::vec3& d : hemisphere_) {
+        const glm::vec3 dir = frame * d;
+        const scene::RayHit hit = caster_.Intersect(origin, dir);
+        if (!hit.IsHit()) {
+          local[k].sky.push_back(dir);
+        } else if (options_.interreflection) {
+          local[k].bounces.push_back(bounce_at(origin + hit.t * dir, hit));
+        }
+      }
+    }
+  });
+  for (size_t k = 0; k < fresh.size(); ++k) {
+    Paths paths;
+    paths.sky_begin = static_cast<uint32_t>(sky_dirs_.size());
+    sky_dirs_.insert(sky_dirs_.end(), local[k].sky.begin(), local[k].sky.end());
+    paths.sky_end = static_cast<uint32_t>(sky_dirs_.size());
+    paths.bounce_begin = static_cast<uint32_t>(bounces_.size());
+    for (Bounce b : local[k].bounces) {
+      const glm::ivec3 q(glm::round(b.normal * 64.0f));
+      const uint64_t key = (static_cast<uint64_t>(q.x + 64) << 16) | (static_cast<uint64_t>(q.y + 64) << 8) |
+                           static_cast<uint64_t>(q.z + 64);
+      const auto [it, inserted] = orientation_of_.emplace(key, static_cast<uint32_t>(orientations_.size()));
+      if (inserted) orientations_.push_back(glm::normalize(glm::vec3(q)));
+      b.orientation = it->second;
+      bounces_.push_back(b);
+    }
+    paths.bounce_end = static_cast<uint32_t>(bounces_.size());
+    slot_[fresh[k]] = static_cast<int32_t>(paths_.size());
+    paths_.push_back(paths);
+  }
+}
+
+std::vector<glm::vec3> CameraTransfer::ClearSkyWeights(const glm::vec3& sun_dir, const glm::vec3& inv_dhi) const {
+  // Midpoint rule on a 2° × 4° grid of the upper hemisphere.
+  constexpr int kRows = 45, kColumns = 90;
+  std::vector<glm::vec3> dirs, radiance;
+  std::vector<float> solid_angle;
+  for (int r = 0; r < kRows; ++r) {
+    const float theta = 0.5f * glm::pi<float>() * (static_cast<float>(r) + 0.5f) / kRows;
+    for (int c = 0; c < kColumns; ++c) {
+      const float phi = 2.0f * glm::pi<float>() * (static_cast<float>(c) + 0.5f) / kColumns;
+      dirs.emplace_back(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+      radiance.push_back(sky_.Radiance(dirs.back(), sun_dir) * inv_dhi);
+      solid_angle.push_back(std::sin(theta) * (0.5f * glm::pi<float>() / kRows) * (2.0f * glm::pi<float>() / kColumns));
+    }
+  }
+  std::vector<glm::vec3> weights(orientations_.size(), glm::vec3(1.0f));
+  for (size_t o = 0; o < orientations_.size(); ++o) {
+    glm::vec3 clear(0.0f);
+    float uniform = 0.0f;
+    for (size_t d = 0; d < dirs.size(); ++d) {
+      const float c = std::max(0.0f, glm::dot(orientations_[o], dirs[d])) * solid_angle[d];
+      clear += radiance[d] * c, uniform += glm::one_over_pi<float>() * c;
+    }
+    if (uniform > 1e-3f) weights[o] = clear / uniform;
+  }
+  return weights;
+}
+
+void CameraTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct,
+                             Transfer* out) {
+  Trace(pixels);
+  const bool day = sun_dir.z > 0.0f;
+  glm::vec3 inv_dhi(0.0f);  // of the clear sky under this sun
+  bool clear_sky = day && !sky_.empty();
+  if (clear_sky) {
+    const glm::dvec3 dhi = sky_.HorizontalIrradiance(sun_dir);
+    clear_sky = glm::compMin(dhi) > 0.0;
+    if (clear_sky) inv_dhi = glm::vec3(1.0 / dhi);
+  }
+  const std::vector<glm::vec3> weights = clear_sky ? ClearSkyWeights(sun_dir, inv_dhi) : std::vector<glm::vec3>{};
+  const float inv_rays = 1.0f / static_cast<float>(hemisphere_.size());
+  const bake::CameraGBuffer& g = bake_.camera;
+  // First bounce: direct light at each bounce point. `reflected` keeps it apart from the direct
+  // terms for the per-surface means of the second.
+  std::vector<Transfer> reflected(pixels.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels.size(), kGrain), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t k = range.begin(); k != range.end(); ++k) {
+      const uint32_t p = pixels[k];
+      const Paths& paths = paths_[static_cast<size_t>(slot_[p])];
+      Transfer t, r;
+      for (uint32_t i = paths.bounce_begin; i < paths.bounce_end; ++i) {
+        const Bounce& b = bounces_[i];
+        const float cos_sun = glm::dot(b.normal, sun_dir);
+        if (day && cos_sun > 0.0f && !caster_.Occluded(b.point, sun_dir)) r.sun += b.albedo * cos_sun;
+        r.overcast += b.albedo * b.sky_visibility;
+        r.clear += b.albedo * b.sky_visibility * (clear_sky ? weights[b.orientation] : glm::vec3(1.0f));
+      }
+      r.sun *= inv_rays, r.clear *= inv_rays, r.overcast *= inv_rays;
+      // The direct sky: V (from the bake's many rays) and, for the clear sky, V times the mean of
+      // its distribution over the directions that reach it.
+      const float v = g.sky_visibility[p];
+      t.sun = glm::vec3(day ? direct[p] : 0.0f);
+      t.overcast = glm::vec3(v);
+      t.clear = glm::vec3(v);
+      if (clear_sky && paths.sky_end > paths.sky_begin) {
+        glm::vec3 sum(0.0f);
+        for (uint32_t d = paths.sky_begin; d < paths.sky_end; ++d) sum += sky_.Radiance(sky_dirs_[d], sun_dir);
+        t.clear = v * glm::pi<float>() * inv_dhi * sum / static_cast<float>(paths.sky_end - paths.sky_begin);
+      }
+      out[k] = t;
+      reflected[k] = r;
+    }
+  });
+  if (!options_.interreflection) return;
+  // Further bounces: each bounce point's own reflected light, as its surface's mean over these
+  // pixels (surfaces without pixels here take the mean of all), iterated: the first pass gives the
+  // second bounce, the next the third.
+  const size_t surfaces = bake_.albedo_table.size();
+  std::vector<Transfer> indirect = reflected;  // all reflected light found so far, per pixel
+  for (int bounce = 2; bounce <= options_.bounces; ++bounce) {
+    std::vector<Transfer> mean(surfaces + 1);
+    std::vector<double> count(surfaces + 1, 0.0);
+    for (size_t k = 0; k < pixels.size(); ++k) {
+      for (const size_t s : {std::min<size_t>(g.surface[pixels[k]], surfaces), surfaces}) {
+        mean[s].sun += indirect[k].sun, mean[s].clear += indirect[k].clear, mean[s].overcast += indirect[k].overcast;
+        count[s] += 1.0;
+      }
+    }
+    for (size_t s = 0; s <= surfaces; ++s) {
+      const size_t from = count[s] > 0.0 ? s : surfaces;
+      const float scale = count[from] > 0.0 ? static_cast<float>(1.0 / count[from]) : 0.0f;
+      mean[s] = {mean[from].sun * scale, mean[from].clear * scale, mean[from].overcast * scale};
+    }
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels.size(), kGrain), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t k = range.begin(); k != range.end(); ++k) {
+        const Paths& paths = paths_[static_cast<size_t>(slot_[pixels[k]])];
+        Transfer further;
+        for (uint32_t i = paths.bounce_begin; i < paths.bounce_end; ++i) {
+          const Bounce& b = bounces_[i];
+          const Transfer& m = mean[std::min<size_t>(b.surface, surfaces)];
+          further.sun += b.albedo * m.sun, further.clear += b.albedo * m.clear, further.overcast += b.albedo * m.overcast;
+        }
+        indirect[k] = {reflected[k].sun + further.sun * inv_rays, reflected[k].clear + further.clear * inv_rays,
+                       reflected[k].overcast + further.overcast * inv_rays};
+      }
+    });
+  }
+  for (size_t k = 0; k < pixels.size(); ++k) {
+    out[k].sun += indirect[k].sun, out[k].clear += indirect[k].clear, out[k].overcast += indirect[k].overcast;
+  }
+}
+
+}  // namespace daylit::estimation

@@ -1,0 +1,108 @@
+// Light transport at camera pixels that stays linear in the light: the "precomputed per-point
+// terms" of docs/design.md that take the model beyond seed 001. Per colour channel,
+//
+//   L(x) = ρ/π · ( E_sun · T_sun(x) + E_clear · T_clear(x) + E_overcast · T_overcast(x) )
+//
+// with E_sun the DNI and E_clear + E_overcast = E_sky the DHI, split between a sky shaped like the
+// captured one (its (θ, γ) distribution: the bright horizon and the aureole around the sun) and a
+// uniform overcast sky. Each T is the irradiance at x per unit of its E:
+//
+//   T_sun      = s·max(0, n·l) + (1/π) ∫ ρ_y · T_sun,y · cos θ dω
+//   T_clear    = ∫ (L_clear(ω) / DHI) · v(x, ω) · cos θ dω + (1/π) ∫ ρ_y · T_clear,y · cos θ dω
+//   T_overcast = V + (1/π) ∫ ρ_y · T_overcast,y · cos θ dω
+//
+// where the integrals run over x's hemisphere and y is the model point a direction ω hits. At y,
+// the direct terms are exact (s_y·max(0, n_y·l) by a shadow ray; V_y, times the clear sky's weight
+// for y's orientation) and y's own reflected light is its surface's mean over the traced pixels,
+// iterated for a third bounce (each bounce off walls of albedo ~0.3-0.5 adds a few percent more). With a uniform sky and no reflection, T_sun = s·max(0, n·l)
+// and T_clear = T_overcast = V: the model of seed 001. The reflected terms are what a courtyard
+// adds: shadowed ground lit by sunlit walls, warm where the walls are red.
+//
+// The paths (which directions reach the sky, which model points the rays hit, and their ρ_y and
+// V_y) do not depend on the sun, so they are traced once per pixel and kept; a new sun costs one
+// shadow ray per bounce point and a table lookup per sky direction.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bake/bake.h"
+#include "bake/capture_light.h"
+#include "scene/raycaster.h"
+
+namespace daylit::estimation {
+
+struct TransferOptions {
+  int rays = 128;               // cosine-weighted hemisphere rays per pixel
+  int hidden_sky_rays = 32;     // rays for V_y at bounce points the capture point does not see
+  float offset_m = 2e-3f;       // ray origins are moved this far along the normal
+  bool interreflection = true;  // the reflected terms
+  int bounces = 3;              // the first exact, the others through per-surface means
+  bool sky_distribution = true; // the captured sky's (θ, γ) distribution; false: a uniform sky
+
+  bool Check(std::string* why) const;
+};
+
+// Irradiance at a point per unit DNI (sun) and per unit DHI of each sky, RGB (reflected light
+// takes the colour of the surfaces it comes from).
+struct Transfer {
+  glm::vec3 sun{0.0f};
+  glm::vec3 clear{0.0f};     // sky in the captured sky's distribution (= overcast without one)
+  glm::vec3 overcast{0.0f};  // uniform sky
+};
+
+class CameraTransfer {
+ public:
+  // `bake`: G-buffer points, normals and V, the env maps (albedo and V of bounce points the
+  // capture point sees), the per-surface albedo (those it does not) and the captured sky.
+  // `capture_position`: scene.envmap.position. Both `bake` and `caster` must outlive this.
+  CameraTransfer(const bake::SceneBake& bake, const glm::vec3& capture_position, const scene::RayCaster& caster,
+                 TransferOptions options = {});
+
+  // T of the G-buffer pixels `pixels` under the unit sun `sun_dir` (z ≤ 0: below the horizon,
+  // T_sun = 0 and both skies are taken as uniform). `direct[p]` is s·max(0, n·l) of G-buffer pixel p.
+  // Traces the paths of pixels seen for the first time (in parallel), then evaluates all of
+  // them (in parallel). out[k] is the transfer of pixels[k].
+  void Compute(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct, Transfer* out);
+
+  size_t TracedPixels() const { return paths_.size(); }
+  // Whether T_clear differs from T_overcast: a captured sky with the sun up.
+  bool HasSkyDistribution() const { return !sky_.empty(); }
+
+ private:
+  struct Bounce {
+    glm::vec3 point;    // already moved off its surface
+    glm::vec3 normal;
+    glm::vec3 albedo;
+    float sky_visibility;
+    uint32_t surface;
+    uint32_t orientation;  // index into orientations_
+  };
+  struct Paths {
+    uint32_t sky_begin = 0, sky_end = 0;        // into sky_dirs_
+    uint32_t bounce_begin = 0, bounce_end = 0;  // into bounces_
+  };
+  void Trace(const std::vector<uint32_t>& pixels);
+  // ∫ (L_clear/DHI) max(0, n·ω) dω / ∫ (1/π) max(0, n·ω) dω over the upper hemisphere, per
+  // orientation: how much more of the clear sky than of a uniform one an open surface receives.
+  std::vector<glm::vec3> ClearSkyWeights(const glm::vec3& sun_dir, const glm::vec3& inv_dhi) const;
+
+  const bake::SceneBake& bake_;
+  glm::vec3 capture_position_;
+  const scene::RayCaster& caster_;
+  TransferOptions options_;
+  bake::SkyDistribution sky_;       // empty: uniform sky
+  std::vector<glm::vec3> hemisphere_;
+  std::vector<int32_t> slot_;       // per G-buffer pixel: index into paths_, −1 until traced
+  std::vector<Paths> paths_;
+  std::vector<glm::vec3> sky_dirs_;
+  std::vector<Bounce> bounces_;
+  std::vector<glm::vec3> orientations_;  // distinct bounce normals (quantised to ~1°)
+  std::unordered_map<uint64_t, uint32_t> orientation_of_;
+};
+
+}  // namespace daylit::estimation
