@@ -141,25 +141,24 @@ SkyDistribution::SkyDistribution(const scene::HdrImage& env, const std::vector<u
   std::vector<uint8_t> g_known(kThetaBins, 0), h_known(kGammaBins, 0);
   const auto index = [](int t, int g) { return static_cast<size_t>(t) * kGammaBins + static_cast<size_t>(g); };
   constexpr int kHorizon = 90;  // the indicatrix h is fitted on the upper hemisphere only
+  // One half-step: each entry i of `fitted` becomes the weighted mean, over the seen bins of its
+  // row (θ: i = t) or column (γ: i = g) among the first `others` of the other axis, of log L less
+  // the other factor.
+  const auto half_step = [&](bool theta, int others, const std::vector<glm::dvec3>& other,
+                             std::vector<glm::dvec3>* fitted, std::vector<uint8_t>* fitted_known) {
+    for (size_t i = 0; i < fitted->size(); ++i) {
+      glm::dvec3 num(0.0);
+      double den = 0.0;
+      for (int j = 0; j < others; ++j) {
+        const size_t b = theta ? index(static_cast<int>(i), j) : index(j, static_cast<int>(i));
+        if (known[b]) num += weight[b] * (glm::dvec3(log_mean[b]) - other[static_cast<size_t>(j)]), den += weight[b];
+      }
+      if (den > 0.0) (*fitted)[i] = num / den, (*fitted_known)[i] = 1;
+    }
+  };
   for (int iteration = 0; iteration < 30; ++iteration) {
-    for (int t = 0; t < kThetaBins; ++t) {
-      glm::dvec3 num(0.0);
-      double den = 0.0;
-      for (int g = 0; g < kGammaBins; ++g) {
-        const size_t b = index(t, g);
-        if (known[b]) num += weight[b] * (glm::dvec3(log_mean[b]) - log_h[static_cast<size_t>(g)]), den += weight[b];
-      }
-      if (den > 0.0) log_g[static_cast<size_t>(t)] = num / den, g_known[static_cast<size_t>(t)] = 1;
-    }
-    for (int g = 0; g < kGammaBins; ++g) {
-      glm::dvec3 num(0.0);
-      double den = 0.0;
-      for (int t = 0; t < kHorizon; ++t) {
-        const size_t b = index(t, g);
-        if (known[b]) num += weight[b] * (glm::dvec3(log_mean[b]) - log_g[static_cast<size_t>(t)]), den += weight[b];
-      }
-      if (den > 0.0) log_h[static_cast<size_t>(g)] = num / den, h_known[static_cast<size_t>(g)] = 1;
-    }
+    half_step(true, kGammaBins, log_h, &log_g, &g_known);
+    half_step(false, kHorizon, log_g, &log_h, &h_known);
   }
   FillFromNearest(&log_g, g_known);
   FillFromNearest(&log_h, h_known);

@@ -36,15 +36,15 @@ std::array<float, 256> CameraResponse::LinearLut8() const {
 }
 
 void CameraResponse::Linearize(const float* encoded, float* linear, size_t count) const {
-  constexpr int kSteps = 4096;
-  std::array<float, kSteps + 1> table{};
-  for (int i = 0; i <= kSteps; ++i) table[static_cast<size_t>(i)] = static_cast<float>(ToLinear(static_cast<double>(i) / kSteps));
-  for (size_t k = 0; k < count; ++k) {
-    const float x = std::clamp(encoded[k], 0.0f, 1.0f) * kSteps;
-    const int i = std::min(static_cast<int>(x), kSteps - 1);
-    const float f = x - static_cast<float>(i);
-    linear[k] = table[static_cast<size_t>(i)] + f * (table[static_cast<size_t>(i) + 1] - table[static_cast<size_t>(i)]);
-  }
+  Linearizer(*this).Apply(encoded, linear, count);
+}
+
+Linearizer::Linearizer(const CameraResponse& response) {
+  for (int i = 0; i <= kSteps; ++i) table_[static_cast<size_t>(i)] = static_cast<float>(response.ToLinear(static_cast<double>(i) / kSteps));
+}
+
+void Linearizer::Apply(const float* encoded, float* linear, size_t count) const {
+  for (size_t k = 0; k < count; ++k) linear[k] = (*this)(encoded[k]);
 }
 
 std::string CameraResponse::Describe() const {

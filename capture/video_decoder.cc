@@ -7,6 +7,7 @@ extern "C" {
 }
 
 #include <algorithm>
+#include <array>
 
 #include "base/error.h"
 #include "base/log.h"
@@ -101,35 +102,37 @@ void Yuv420ToRgb(const uint8_t* y, int y_stride, const uint8_t* u, int u_stride,
   const float r_cr = 2.0f * (1.0f - kr), b_cb = 2.0f * (1.0f - kb);
   const float g_cb = -b_cb * kb / kg, g_cr = -r_cr * kr / kg;
   const int cw = (width + 1) / 2, ch = (height + 1) / 2;
-  // Chroma upsampled to full resolution first (bilinear; left-sited horizontally, centred
-  // vertically), then the matrix per pixel.
-  std::vector<float> cb(static_cast<size_t>(width) * height), cr(cb.size());
+  // Chroma is upsampled bilinearly (left-sited horizontally, centred vertically). The matrix is
+  // linear in Cb and Cr, so each row first gets the three chroma terms of the matrix at the
+  // chroma columns (interpolated vertically), and each pixel adds its luma to the terms at its
+  // column (interpolated horizontally: an even column sits on a chroma sample, an odd one halfway).
+  std::array<float, 256> luma_of{};
+  for (int code = 0; code < 256; ++code) luma_of[static_cast<size_t>(code)] = (static_cast<float>(code) - 16.0f) / 219.0f;
+  std::vector<float> r_term(static_cast<size_t>(cw) + 1), g_term(r_term.size()), b_term(r_term.size());
   for (int row = 0; row < height; ++row) {
     const float cy = std::clamp((static_cast<float>(row) - 0.5f) * 0.5f, 0.0f, static_cast<float>(ch - 1));
     const int y0 = static_cast<int>(cy), y1 = std::min(y0 + 1, ch - 1);
     const float fy = cy - static_cast<float>(y0);
-    for (int col = 0; col < width; ++col) {
-      const float cx = std::min(static_cast<float>(col) * 0.5f, static_cast<float>(cw - 1));
-      const int x0 = static_cast<int>(cx), x1 = std::min(x0 + 1, cw - 1);
-      const float fx = cx - static_cast<float>(x0);
-      const auto sample = [&](const uint8_t* plane, int stride) {
-        const float top = (1 - fx) * plane[y0 * stride + x0] + fx * plane[y0 * stride + x1];
-        const float bottom = (1 - fx) * plane[y1 * stride + x0] + fx * plane[y1 * stride + x1];
-        return ((1 - fy) * top + fy * bottom - 128.0f) / 224.0f;
-      };
-      const size_t i = static_cast<size_t>(row) * width + col;
-      cb[i] = sample(u, u_stride);
-      cr[i] = sample(v, v_stride);
+    const uint8_t *u0 = u + y0 * u_stride, *u1 = u + y1 * u_stride, *v0 = v + y0 * v_stride, *v1 = v + y1 * v_stride;
+    for (int x = 0; x < cw; ++x) {
+      const float cb = ((1.0f - fy) * u0[x] + fy * u1[x] - 128.0f) / 224.0f;
+      const float cr = ((1.0f - fy) * v0[x] + fy * v1[x] - 128.0f) / 224.0f;
+      r_term[static_cast<size_t>(x)] = r_cr * cr;
+      g_term[static_cast<size_t>(x)] = g_cb * cb + g_cr * cr;
+      b_term[static_cast<size_t>(x)] = b_cb * cb;
     }
-  }
-  for (int row = 0; row < height; ++row) {
-    cv::Vec3f* out = rgb->ptr<cv::Vec3f>(row);
+    // Past the last chroma column the last one repeats.
+    r_term[static_cast<size_t>(cw)] = r_term[static_cast<size_t>(cw) - 1];
+    g_term[static_cast<size_t>(cw)] = g_term[static_cast<size_t>(cw) - 1];
+    b_term[static_cast<size_t>(cw)] = b_term[static_cast<size_t>(cw) - 1];
+    const uint8_t* luma = y + row * y_stride;
+    float* out = rgb->ptr<float>(row);
     for (int col = 0; col < width; ++col) {
-      const size_t i = static_cast<size_t>(row) * width + col;
-      const float luma = (static_cast<float>(y[row * y_stride + col]) - 16.0f) / 219.0f;
-      out[col][0] = std::clamp(luma + r_cr * cr[i], 0.0f, 1.0f);
-      out[col][1] = std::clamp(luma + g_cb * cb[i] + g_cr * cr[i], 0.0f, 1.0f);
-      out[col][2] = std::clamp(luma + b_cb * cb[i], 0.0f, 1.0f);
+      const size_t x0 = static_cast<size_t>(col >> 1), x1 = x0 + static_cast<size_t>(col & 1);
+      const float l = luma_of[luma[col]];
+      out[3 * col + 0] = std::clamp(l + 0.5f * (r_term[x0] + r_term[x1]), 0.0f, 1.0f);
+      out[3 * col + 1] = std::clamp(l + 0.5f * (g_term[x0] + g_term[x1]), 0.0f, 1.0f);
+      out[3 * col + 2] = std::clamp(l + 0.5f * (b_term[x0] + b_term[x1]), 0.0f, 1.0f);
     }
   }
 }

@@ -1,6 +1,11 @@
 #include "estimation/recording_estimator.h"
 
+#include <tbb/concurrent_queue.h>
+
+#include <atomic>
 #include <chrono>
+#include <exception>
+#include <thread>
 #include <cmath>
 #include <map>
 
@@ -25,38 +30,78 @@ using Clock = std::chrono::steady_clock;
 
 double Median(std::vector<double> v) { return MedianInPlace(v, static_cast<double>(NAN)); }
 
-// Frames in order, as linear RGB floats; one source for videos and image sequences.
-class FrameReader {
+// One frame as the estimator reads it: encoded RGB floats (video, PNG, JPEG) or linear ones (EXR).
+struct DecodedFrame {
+  size_t position = 0;  // in frames.csv
+  bool ok = false;
+  bool linear = false;
+  cv::Mat rgb;
+  std::exception_ptr error;  // a failure that is not the frame's own: ends the run
+};
+
+// Reads the frames in order on its own thread, a few ahead of the estimation, so that decoding
+// and estimating overlap.
+class FramePipeline {
  public:
-  explicit FrameReader(const scene::Scene& scene) : scene_(scene) {
+  explicit FramePipeline(const scene::Scene& scene) : scene_(scene) {
     if (scene.frames.kind == scene::FrameSourceKind::kVideo) video_ = std::make_unique<capture::VideoDecoder>(scene.frames.video);
+    queue_.set_capacity(4);
+    thread_ = std::thread([this] { Run(); });
   }
-  // Returns false when frame `index` cannot be read (decoded is then empty).
-  bool Read(int index, cv::Mat* linear) {
-    cv::Mat encoded;
-    if (video_) {
-      if (!video_->Next(&encoded)) return false;
-    } else {
-      const std::filesystem::path path = scene_.frames.ImagePath(index);
-      if (path.extension() == ".exr") {
-        scene::HdrImage image = scene::ReadHdrImage(path);  // already linear
-        cv::Mat(image.height, image.width, CV_32FC3, image.rgb.data()).copyTo(*linear);
-        return true;
-      }
-      const cv::Mat bgr = cv::imread(path.string(), cv::IMREAD_COLOR);
-      if (bgr.empty()) return false;
-      cv::Mat rgb;
-      cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
-      rgb.convertTo(encoded, CV_32FC3, 1.0 / 255.0);
-    }
-    linear->create(encoded.size(), CV_32FC3);
-    scene_.response.Linearize(encoded.ptr<float>(), linear->ptr<float>(), encoded.total() * 3);
-    return true;
+  ~FramePipeline() {
+    stop_ = true;
+    DecodedFrame dropped;
+    while (queue_.try_pop(dropped)) {}
+    thread_.join();
+  }
+  DecodedFrame Next() {
+    DecodedFrame frame;
+    queue_.pop(frame);
+    if (frame.error) std::rethrow_exception(frame.error);
+    return frame;
   }
 
  private:
+  void Run() {
+    const std::vector<capture::FrameTime>& times = scene_.frame_times->frames;
+    for (size_t i = 0; i < times.size() && !stop_; ++i) {
+      DecodedFrame frame;
+      frame.position = i;
+      try {
+        frame.ok = Read(times[i].index, &frame);
+      } catch (const InputError& e) {
+        Log().warn("{}", e.what());
+        frame.ok = false;
+      } catch (...) {
+        frame.error = std::current_exception();
+      }
+      const bool failed = static_cast<bool>(frame.error);
+      while (!stop_ && !queue_.try_push(frame)) std::this_thread::yield();
+      if (failed) return;
+    }
+  }
+  bool Read(int index, DecodedFrame* frame) {
+    if (video_) return video_->Next(&frame->rgb);
+    const std::filesystem::path path = scene_.frames.ImagePath(index);
+    if (path.extension() == ".exr") {
+      scene::HdrImage image = scene::ReadHdrImage(path);  // already linear
+      cv::Mat(image.height, image.width, CV_32FC3, image.rgb.data()).copyTo(frame->rgb);
+      frame->linear = true;
+      return true;
+    }
+    const cv::Mat bgr = cv::imread(path.string(), cv::IMREAD_COLOR);
+    if (bgr.empty()) return false;
+    cv::Mat rgb;
+    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+    rgb.convertTo(frame->rgb, CV_32FC3, 1.0 / 255.0);
+    return true;
+  }
+
   const scene::Scene& scene_;
   std::unique_ptr<capture::VideoDecoder> video_;
+  tbb::concurrent_bounded_queue<DecodedFrame> queue_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
 };
 
 }  // namespace
@@ -67,16 +112,17 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
   const glm::vec3 capture = scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f);
   Sampler sampler(bake, capture, caster, options.sampler);
   TemporalFilter filter(options.filter);
-  FrameReader reader(scene);
+  const capture::Linearizer linearizer(scene.response);
   const sunmodel::Atmosphere atmosphere = sunmodel::Atmosphere::Standard(scene.location.elevation_m);
   const sunmodel::SceneGeoFrame geo = scene.GeoFrame();
   const std::vector<capture::FrameTime>& times = scene.frame_times->frames;
   EstimateRun run;
   Progress progress("estimate", times.size());
   const Clock::time_point start = Clock::now();
-  double estimate_s = 0.0;
-  cv::Mat linear;
+  std::vector<double> frame_ms;  // estimation after decoding, frames without a sun move
+  FramePipeline frames(scene);
   for (size_t i = 0; i < times.size(); ++i) {
+    const DecodedFrame decoded = frames.Next();
     FrameEstimate row;
     row.frame = times[i].index;
     row.time_utc = times[i].utc;
@@ -84,7 +130,7 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
     row.sun_elevation_deg = sun.ApparentElevationDeg();
     row.sun_azimuth_deg = sun.azimuth_deg;
     const double t_s = times[i].utc.SecondsSince(times.front().utc);
-    if (!reader.Read(row.frame, &linear) || linear.cols != bake.camera.width || linear.rows != bake.camera.height) {
+    if (!decoded.ok || decoded.rgb.cols != bake.camera.width || decoded.rgb.rows != bake.camera.height) {
       row.decoded = false;
       ++run.undecodable;
       Log().warn("{}: frame {} cannot be decoded; skipped", scene.file.string(), row.frame);
@@ -94,13 +140,19 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
       progress.Advance();
       continue;
     }
-    const Clock::time_point decoded = Clock::now();
-    sampler.SetSun(glm::vec3(geo.DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg)));
-    const std::vector<Sample> samples = sampler.Draw(linear, times[i].exposure.value_or(scene.exposure));
+    const Clock::time_point began = Clock::now();
+    const bool moved = sampler.SetSun(glm::vec3(geo.DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg)));
+    const std::vector<Sample> samples = sampler.Draw(decoded.rgb, times[i].exposure.value_or(scene.exposure),
+                                                     decoded.linear ? nullptr : &linearizer);
     const SunSkyFitSummary fit = FitSunSky(options.fit, samples);
     const FilteredLight filtered =
         filter.Update(t_s, fit.IsUsable() ? std::optional<SunSky>(fit.light) : std::nullopt, fit.confidence);
-    estimate_s += std::chrono::duration<double>(Clock::now() - decoded).count();
+    const double ms = 1e3 * std::chrono::duration<double>(Clock::now() - began).count();
+    if (moved) {
+      run.sun_moves_ms.push_back(ms);
+    } else {
+      frame_ms.push_back(ms);
+    }
     row.light = filtered.light;
     row.confidence = filtered.confidence;
     row.samples = static_cast<int>(samples.size());
@@ -109,8 +161,8 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     progress.SetSuffix(fmt::format("{:.0f} fps", static_cast<double>(i + 1) / std::max(elapsed, 1e-9)));
   }
+  run.median_frame_ms = Median(frame_ms);
   run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  run.estimate_seconds = estimate_s;
   return run;
 }
 

@@ -36,8 +36,9 @@ struct FrameEstimate {
 struct EstimateRun {
   std::vector<FrameEstimate> frames;
   int undecodable = 0;
-  double seconds = 0.0;         // wall time of the loop, decoding included
-  double estimate_seconds = 0.0;  // of which: everything after decoding
+  double seconds = 0.0;               // wall time of the loop, decoding included (on its own thread)
+  double median_frame_ms = 0.0;       // everything after decoding, median over frames without a sun move
+  std::vector<double> sun_moves_ms;   // the frames with one: shadow rays, strata, transfer terms
 };
 
 // Runs over every frame of a recorded scene (video or images). Throws InputError for a scene

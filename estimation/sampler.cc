@@ -105,9 +105,9 @@ bool Sampler::SetSun(const glm::vec3& sun_dir) {
   return true;
 }
 
-std::vector<Sample> Sampler::Draw(const cv::Mat& linear, double exposure) const {
+std::vector<Sample> Sampler::Draw(const cv::Mat& frame, double exposure, const capture::Linearizer* linearizer) const {
   std::vector<Sample> samples;
-  if (strata_.empty() || linear.empty()) return samples;
+  if (strata_.empty() || frame.empty()) return samples;
   samples.reserve(static_cast<size_t>(options_.samples));
   const size_t quota = static_cast<size_t>(options_.samples) / strata_.size() + 1;
   const float inv_exposure = static_cast<float>(1.0 / exposure);
@@ -115,7 +115,8 @@ std::vector<Sample> Sampler::Draw(const cv::Mat& linear, double exposure) const 
     size_t taken = 0;
     for (size_t k = 0; k < stratum.size() && taken < quota; ++k) {
       const uint32_t i = stratum[k].pixel;
-      const cv::Vec3f& p = linear.at<cv::Vec3f>(static_cast<int>(i / gbuffer_.width), static_cast<int>(i % gbuffer_.width));
+      cv::Vec3f p = frame.at<cv::Vec3f>(static_cast<int>(i / gbuffer_.width), static_cast<int>(i % gbuffer_.width));
+      if (linearizer != nullptr) p = cv::Vec3f((*linearizer)(p[0]), (*linearizer)(p[1]), (*linearizer)(p[2]));
       bool usable = true;
       for (int c = 0; c < 3; ++c) usable = usable && p[c] < options_.saturated && p[c] > options_.near_black;
       if (!usable) continue;

@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 
 #include "bake/bake.h"
+#include "capture/response.h"
 #include "estimation/sun_sky_fit.h"
 #include "estimation/transfer.h"
 #include "scene/raycaster.h"
@@ -41,9 +42,10 @@ class Sampler {
   // everything is shadowed). Cheap when the sun has not moved enough. Returns true if it re-cast.
   bool SetSun(const glm::vec3& sun_dir);
 
-  // Samples of one frame: `linear` is the frame as linear RGB floats (CV_32FC3, R G B order,
-  // before dividing out the exposure), `exposure` the k of "linear pixel = k · radiance".
-  std::vector<Sample> Draw(const cv::Mat& linear, double exposure) const;
+  // Samples of one frame: `frame` as RGB floats (CV_32FC3, R G B order), linear (before dividing
+  // out the exposure) or, with `linearizer`, encoded and linearised here, only where read.
+  // `exposure` is the k of "linear pixel = k · radiance".
+  std::vector<Sample> Draw(const cv::Mat& frame, double exposure, const capture::Linearizer* linearizer = nullptr) const;
 
   size_t StratumCount() const { return strata_.size(); }
   // The current sun visibility of each pixel (1: sunlit), and its boundary exclusion mask.

@@ -68,6 +68,26 @@ TEST(SamplerTest, ExactSyntheticFrameIsRecoveredTo0_1Percent) {
   }
 }
 
+TEST(SamplerTest, AnEncodedFrameIsLinearisedWhereRead) {
+  const WallScene w;
+  Sampler sampler(w.bake, w.Capture(), *w.caster, WallScene::SeedModel());
+  sampler.SetSun(w.sun);
+  const SunSky light{{86.0, 63.0, 37.0}, {9.9, 9.7, 10.0}};
+  const cv::Mat linear = w.Render(sampler, light, 0.004);
+  const capture::CameraResponse srgb;
+  cv::Mat encoded = linear.clone();
+  for (auto it = encoded.begin<cv::Vec3f>(); it != encoded.end<cv::Vec3f>(); ++it) {
+    for (int c = 0; c < 3; ++c) (*it)[c] = static_cast<float>(srgb.ToEncoded((*it)[c]));
+  }
+  const capture::Linearizer linearizer(srgb);
+  const std::vector<Sample> want = sampler.Draw(linear, 0.004);
+  const std::vector<Sample> got = sampler.Draw(encoded, 0.004, &linearizer);
+  ASSERT_EQ(got.size(), want.size());
+  for (size_t i = 0; i < got.size(); ++i) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[i].radiance[c], want[i].radiance[c], 1e-4 * want[i].radiance[c]) << i;
+  }
+}
+
 TEST(SamplerTest, ShadowEdgesClippedAndDarkPixelsAreLeftOut) {
   const WallScene w;
   Sampler sampler(w.bake, w.Capture(), *w.caster, WallScene::SeedModel());

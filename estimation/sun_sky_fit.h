@@ -35,7 +35,7 @@ struct Sample {
 
 struct SunSkyFitOptions {
   double cauchy_scale = 0.1;        // relative residual at which a sample's weight halves
-  int iterations = 12;              // IRLS iterations
+  int iterations = 8;              // IRLS iterations
   double sunlit_threshold = 0.05;   // s·max(0, n·l) above this: a sample that sees the sun well
   int min_stratum_samples = 30;     // per stratum (sunlit, shadowed) for full confidence
   double confident_residual = 0.25; // robust relative residual spread at which confidence is 1/e

@@ -46,11 +46,17 @@ FilteredLight TemporalFilter::Update(double time_s, const std::optional<SunSky>&
   }
   // While the window fills after a restart, the median of what there is.
   const SunSky target = WindowMedian(window_);
-  // A fixed gain: the confidence gates frames (above), it does not slow the filter. A scene
-  // whose model fits only to 20% still follows a cloud frame by frame.
-  const double gain = options_.smoothing;
-  state_->light.sun_rgb += gain * (target.sun_rgb - state_->light.sun_rgb);
-  state_->light.sky_rgb += gain * (target.sky_rgb - state_->light.sky_rgb);
+  // Per channel, a change within the noise band (a share of the channel's E_sun + E_sky) is
+  // smoothed with gain `smoothing`; what lies beyond it is taken at once. Noise is damped, a
+  // cloud edge is followed on the frame it arrives, lagging by at most (1 − gain)·band.
+  for (int c = 0; c < 3; ++c) {
+    const double band = options_.noise_band * (state_->light.sun_rgb[c] + state_->light.sky_rgb[c]);
+    for (double* value : {&state_->light.sun_rgb[c], &state_->light.sky_rgb[c]}) {
+      const double d = (value == &state_->light.sun_rgb[c] ? target.sun_rgb[c] : target.sky_rgb[c]) - *value;
+      const double small = std::clamp(d, -band, band);
+      *value += options_.smoothing * small + (d - small);
+    }
+  }
   state_->confidence += options_.smoothing * (confidence - state_->confidence);
   return *state_;
 }

@@ -37,8 +37,8 @@
 namespace daylit::estimation {
 
 struct TransferOptions {
-  int rays = 128;               // cosine-weighted hemisphere rays per pixel
-  int hidden_sky_rays = 32;     // rays for V_y at bounce points the capture point does not see
+  int rays = 256;               // cosine-weighted hemisphere rays per pixel
+  int hidden_sky_rays = 64;     // rays for V_y of bounce points the capture point does not see (per cell)
   float offset_m = 2e-3f;       // ray origins are moved this far along the normal
   bool interreflection = true;  // the reflected terms
   int bounces = 3;              // the first exact, the others through per-surface means
@@ -83,13 +83,21 @@ class CameraTransfer {
     uint32_t orientation;  // index into orientations_
   };
   struct Paths {
-    uint32_t sky_begin = 0, sky_end = 0;        // into sky_dirs_
-    uint32_t bounce_begin = 0, bounce_end = 0;  // into bounces_
+    uint32_t orientation = 0;                     // of the pixel's normal
+    uint32_t low_sky_begin = 0, low_sky_end = 0;  // into low_sky_
+    uint32_t blocked_begin = 0, blocked_end = 0;  // into blocked_
+    uint32_t bounce_begin = 0, bounce_end = 0;    // into bounces_
+  };
+  struct OpenSky {
+    glm::vec3 clear{0.0f};  // ∫ (L_clear/DHI) max(0, n·ω) dω over the upper hemisphere
+    float uniform = 0.0f;   // ∫ (1/π) max(0, n·ω) dω over the upper hemisphere
   };
   void Trace(const std::vector<uint32_t>& pixels);
-  // ∫ (L_clear/DHI) max(0, n·ω) dω / ∫ (1/π) max(0, n·ω) dω over the upper hemisphere, per
-  // orientation: how much more of the clear sky than of a uniform one an open surface receives.
-  std::vector<glm::vec3> ClearSkyWeights(const glm::vec3& sun_dir, const glm::vec3& inv_dhi) const;
+  uint32_t OrientationOf(const glm::vec3& normal);  // index into orientations_, added if new
+  static constexpr float kCellSize = 0.25f;         // m, for V of hidden bounce points
+  static uint64_t CellOf(const Bounce& b);          // surface, cell and side (hashed)
+  // What an unoccluded surface of each orientation receives from the clear sky and a uniform one.
+  std::vector<OpenSky> OpenSkyIntegrals(const glm::vec3& sun_dir, const glm::vec3& inv_dhi) const;
 
   const bake::SceneBake& bake_;
   glm::vec3 capture_position_;
@@ -99,10 +107,11 @@ class CameraTransfer {
   std::vector<glm::vec3> hemisphere_;
   std::vector<int32_t> slot_;       // per G-buffer pixel: index into paths_, −1 until traced
   std::vector<Paths> paths_;
-  std::vector<glm::vec3> sky_dirs_;
+  std::vector<glm::vec3> low_sky_, blocked_;
   std::vector<Bounce> bounces_;
-  std::vector<glm::vec3> orientations_;  // distinct bounce normals (quantised to ~1°)
+  std::vector<glm::vec3> orientations_;  // distinct normals of pixels and bounce points (to ~1°)
   std::unordered_map<uint64_t, uint32_t> orientation_of_;
+  std::unordered_map<uint64_t, float> hidden_cells_;  // V per cell of hidden bounce points
 };
 
 }  // namespace daylit::estimation

@@ -6,7 +6,9 @@
 #   sun.png   the sun's elevation and azimuth over the recording
 #   bake/     the offline scene maps (env-map and camera albedo, sky visibility, gather tables,
 #             albedo.csv, PNG previews); re-used while the recording is unchanged
-# Later parts of the pipeline (bake, estimation, relighting, rendering) join this job as they land.
+#   estimates.csv, lighting.png, lighting.txt
+#             the sun and sky per frame, their plot, and (with ground truth) the median errors
+# Later parts of the pipeline (relighting, rendering) join this job as they land.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 recording=${1:-recordings/courtyard-a}
@@ -21,4 +23,7 @@ mv "$out/info.txt.tmp" "$out/info.txt"
 "$daylit" bake "$recording" --cache "$out/bake" >/dev/null
 echo "albedo per surface (from the env map):"
 cat "$out/bake/albedo.csv"
+"$daylit" estimate "$recording" --cache "$out/bake" --out "$out/estimates.csv" --plot "$out/lighting.png" \
+  | tee "$out/lighting.txt.tmp"
+mv "$out/lighting.txt.tmp" "$out/lighting.txt"
 echo "results in $out/"

@@ -30,9 +30,12 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   const estimation::EstimateRun run = estimation::EstimateRecording(scene, baked, o.estimate);
   WriteFileAtomically(o.out, estimation::EstimatesCsv(run.frames));
   const size_t n = run.frames.size();
-  Log().info("{} frames in {:.2f} s ({:.0f} fps end to end; estimation after decoding {:.2f} ms per frame); wrote {}",
-             n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9),
-             1e3 * run.estimate_seconds / static_cast<double>(std::max<size_t>(n, 1)), o.out);
+  double moves_ms = 0.0;
+  for (const double ms : run.sun_moves_ms) moves_ms += ms;
+  Log().info("{} frames in {:.2f} s ({:.0f} fps end to end); estimation after decoding {:.2f} ms per frame (median), "
+             "plus {} sun moves taking {:.0f} ms in all; wrote {}",
+             n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9), run.median_frame_ms,
+             run.sun_moves_ms.size(), moves_ms, o.out);
   if (run.undecodable > 0) Log().warn("{} frames could not be decoded", run.undecodable);
   const std::string plot = o.plot.empty() ? std::filesystem::path(o.out).replace_extension(".png").string() : o.plot;
   std::optional<estimation::TruthComparison> truth;

@@ -1,0 +1,138 @@
+// The estimation's figures on the bundled recording (960×540): per-frame estimation after decoding
+// (bar ≤ 2 ms median on one core), its parts, decoding alone (the capture issue's bar ≥ 200 fps),
+// and the cost of a sun move (shadow rays and transfer terms, re-run when the sun moved > 0.05°).
+#include <benchmark/benchmark.h>
+
+#include <tbb/global_control.h>
+
+#include "bake/bake.h"
+#include "base/log.h"
+#include "capture/video_decoder.h"
+#include "estimation/sampler.h"
+#include "estimation/temporal_filter.h"
+#include "scene/scene.h"
+
+namespace daylit::estimation {
+namespace {
+
+struct Courtyard {
+  scene::Scene scene = scene::LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a");
+  bake::SceneBake bake;
+  std::unique_ptr<scene::RayCaster> caster;
+  cv::Mat encoded, linear;  // frame 50 (clear), as decoded and linearised
+  double exposure = 0.0;
+  glm::vec3 sun{0.0f};
+
+  Courtyard() {
+    SetLogVerbosity(0);
+    bool loaded = false;
+    bake = bake::BakeOrLoad(scene, bake::BakeOptions{}, DAYLIT_BINARY_DIR "/bench-cache/courtyard-a", &loaded);
+    caster = std::make_unique<scene::RayCaster>(scene.model);
+    capture::VideoDecoder decoder(scene.frames.video);
+    for (int i = 0; i <= 50; ++i) decoder.Next(&encoded);
+    linear.create(encoded.size(), CV_32FC3);
+    scene.response.Linearize(encoded.ptr<float>(), linear.ptr<float>(), encoded.total() * 3);
+    exposure = scene.frame_times->frames[50].exposure.value_or(scene.exposure);
+    sun = glm::vec3(0.9571569f, -0.0397556f, 0.2868279f);  // burst 0 (info.json)
+  }
+  static Courtyard& Get() {
+    static Courtyard c;
+    return c;
+  }
+  glm::vec3 Capture() const { return glm::vec3(scene.envmap->position); }
+};
+
+void BM_DecodeFrame(benchmark::State& state) {
+  const Courtyard& c = Courtyard::Get();
+  auto decoder = std::make_unique<capture::VideoDecoder>(c.scene.frames.video);
+  cv::Mat rgb;
+  for (auto _ : state) {
+    if (!decoder->Next(&rgb)) {
+      state.PauseTiming();
+      decoder = std::make_unique<capture::VideoDecoder>(c.scene.frames.video);
+      state.ResumeTiming();
+      decoder->Next(&rgb);
+    }
+    benchmark::DoNotOptimize(rgb.data);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_DecodeFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_LinearizeFrame(benchmark::State& state) {
+  const Courtyard& c = Courtyard::Get();
+  cv::Mat linear(c.encoded.size(), CV_32FC3);
+  for (auto _ : state) {
+    c.scene.response.Linearize(c.encoded.ptr<float>(), linear.ptr<float>(), c.encoded.total() * 3);
+    benchmark::DoNotOptimize(linear.data);
+  }
+}
+BENCHMARK(BM_LinearizeFrame)->Unit(benchmark::kMillisecond);
+
+void BM_Draw(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  Sampler sampler(c.bake, c.Capture(), *c.caster);
+  sampler.SetSun(c.sun);
+  for (auto _ : state) {
+    const std::vector<Sample> samples = sampler.Draw(c.linear, c.exposure);
+    benchmark::DoNotOptimize(samples.data());
+  }
+}
+BENCHMARK(BM_Draw)->Unit(benchmark::kMillisecond);
+
+void BM_FitSunSky(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  Sampler sampler(c.bake, c.Capture(), *c.caster);
+  sampler.SetSun(c.sun);
+  const std::vector<Sample> samples = sampler.Draw(c.linear, c.exposure);
+  for (auto _ : state) {
+    const SunSkyFitSummary fit = FitSunSky({}, samples);
+    benchmark::DoNotOptimize(fit.light.sun_rgb.x);
+  }
+  state.counters["samples"] = static_cast<double>(samples.size());
+}
+BENCHMARK(BM_FitSunSky)->Unit(benchmark::kMillisecond);
+
+// Everything after decoding and linearisation for one frame: samples, fit, filter.
+void BM_EstimateFrame(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  Sampler sampler(c.bake, c.Capture(), *c.caster);
+  sampler.SetSun(c.sun);
+  TemporalFilter filter(TemporalFilterOptions{});
+  double t = 0.0;
+  for (auto _ : state) {
+    const std::vector<Sample> samples = sampler.Draw(c.linear, c.exposure);
+    const SunSkyFitSummary fit = FitSunSky({}, samples);
+    const FilteredLight light = filter.Update(t += 0.1, fit.light, fit.confidence);
+    benchmark::DoNotOptimize(light.light.sun_rgb.x);
+  }
+}
+BENCHMARK(BM_EstimateFrame)->Unit(benchmark::kMillisecond);
+
+// A sun move: shadow rays for every model pixel, new strata, transfer terms of the pools (paths
+// already traced: the first move traces them, which is timed apart).
+void BM_SunMove(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  Sampler sampler(c.bake, c.Capture(), *c.caster);
+  sampler.SetSun(c.sun);
+  int k = 0;
+  for (auto _ : state) {
+    const float turn = (++k % 2 ? 0.1f : -0.1f) * 0.0175f;  // ±0.1° about the vertical
+    const glm::vec3 sun(c.sun.x * std::cos(turn) - c.sun.y * std::sin(turn),
+                        c.sun.x * std::sin(turn) + c.sun.y * std::cos(turn), c.sun.z);
+    benchmark::DoNotOptimize(sampler.SetSun(sun));
+  }
+}
+BENCHMARK(BM_SunMove)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_FirstSun(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  for (auto _ : state) {
+    Sampler sampler(c.bake, c.Capture(), *c.caster);
+    benchmark::DoNotOptimize(sampler.SetSun(c.sun));
+  }
+}
+BENCHMARK(BM_FirstSun)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
+}  // namespace
+}  // namespace daylit::estimation
