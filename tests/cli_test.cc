@@ -167,6 +167,26 @@ TEST(CliTest, EstimateWritesTheStableCsv) {
   EXPECT_TRUE(fs::is_regular_file(rec.dir / "est.png"));
 }
 
+TEST(CliTest, EstimateSkipsAFrameThatCannotBeDecodedAndGoesOn) {
+  bake::testing::SyntheticRecording rec("cli_estimate_corrupt");
+  const std::string scene = rec.Write().string();
+  // Three frames; the middle one's file is not an image.
+  fs::copy_file(rec.dir / "frames" / "000000.png", rec.dir / "frames" / "000002.png");
+  WriteFileAtomically(rec.dir / "frames" / "000001.png", "not a png");
+  WriteFileAtomically(rec.dir / "frames.csv",
+                      "frame,time_utc\n0,2026-06-21T00:00:00Z\n1,2026-06-21T00:00:00.1Z\n2,2026-06-21T00:00:00.2Z\n");
+  const fs::path out = rec.dir / "est.csv";
+  const CliRun run = Daylit("estimate " + scene + " --cache " + (rec.dir / "cache").string() + " --out " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("frame 1 cannot be decoded; skipped"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("1 frames could not be decoded"), std::string::npos) << run.err;
+  const CsvTable table = ReadCsvFile(out);
+  ASSERT_EQ(table.rows.size(), 3u);
+  // The skipped frame holds the estimate of the one before.
+  EXPECT_EQ(table.rows[1][7], table.rows[0][7]);
+  EXPECT_EQ(table.rows[2][7], table.rows[0][7]);
+}
+
 struct BadCall {
   std::string args;
   std::string error;  // expected on stderr
