@@ -268,6 +268,22 @@ CameraGBuffer ComputeCameraGBuffer(const scene::Scene& scene, const scene::RayCa
   return g;
 }
 
+// Where a probe gathers from. A probe on a surface (the volume's floor lying on the ground) would
+// send half its rays along that surface, through it or not by rounding, and read the map through
+// it; it gathers from 2 cm in front of the surface instead.
+glm::vec3 GatherOrigin(const scene::RayCaster& caster, const glm::vec3& probe) {
+  constexpr float kClearance = 0.02f;
+  for (const glm::vec3& d : {glm::vec3(0, 0, 1), glm::vec3(0, 0, -1), glm::vec3(1, 0, 0), glm::vec3(-1, 0, 0),
+                             glm::vec3(0, 1, 0), glm::vec3(0, -1, 0)}) {
+    // From 2 cm out along d back toward the probe and 2 cm past it: a front face there is a
+    // surface through or next to the probe.
+    const glm::vec3 start = probe + kClearance * d;
+    const scene::RayHit hit = caster.Intersect(start, -d, 0.0f, 2.0f * kClearance);
+    if (hit.IsHit() && !hit.back_face) return start - hit.t * d + kClearance * hit.normal;
+  }
+  return probe;
+}
+
 GatherTables ComputeGatherTables(const scene::Scene& scene, const scene::RayCaster& caster, const BakeOptions& options,
                                  const EnvMapMaps& env) {
   GatherTables gather;
@@ -283,8 +299,9 @@ GatherTables ComputeGatherTables(const scene::Scene& scene, const scene::RayCast
   for (int k = 0; k < gather.resolution.z; ++k) {
     for (int j = 0; j < gather.resolution.y; ++j) {
       for (int i = 0; i < gather.resolution.x; ++i, ++probe) {
+        const glm::vec3 origin = GatherOrigin(caster, gather.ProbePosition(i, j, k));
         for (size_t d = 0; d < dirs; ++d) {
-          origins[probe * dirs + d] = gather.ProbePosition(i, j, k);
+          origins[probe * dirs + d] = origin;
           rays[probe * dirs + d] = gather.directions[d];
         }
       }

@@ -20,11 +20,11 @@ namespace daylit::bake {
 
 inline constexpr uint32_t kNoSurface = 0xFFFFFFFFu;  // sky, or no point
 // Bumped whenever the bake computes something differently, so that old caches are re-baked.
-inline constexpr const char* kBakeFormat = "daylit-bake/4";
+inline constexpr const char* kBakeFormat = "daylit-bake/5";
 
 struct BakeOptions {
   RayOptions rays;
-  int gather_directions = 256;  // per probe, spherical Fibonacci
+  int gather_directions = 512;  // per probe, spherical Fibonacci
   DetailOptions detail;         // camera albedo detail from the recording's frames
 
   bool Check(std::string* why) const;  // ray counts in [16, 65536], offset in (0, 0.1] m

@@ -19,7 +19,7 @@ TEST(EstimateRecordingTest, CourtyardLightingWithin5PercentOfTheTruth) {
   const scene::Scene scene = scene::LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a");
   bool loaded = false;
   const bake::SceneBake baked =
-      bake::BakeOrLoad(scene, bake::BakeOptions{}, DAYLIT_BINARY_DIR "/test-cache/estimate-courtyard-a", &loaded);
+      bake::BakeOrLoad(scene, bake::BakeOptions{}, DAYLIT_BINARY_DIR "/test-cache/courtyard-a", &loaded);
   const estimation::EstimateRun run = estimation::EstimateRecording(scene, baked, {});
   ASSERT_EQ(run.frames.size(), 600u);
   EXPECT_EQ(run.undecodable, 0);

@@ -1,0 +1,60 @@
+// The irradiance volume of seed 001: a grid of probes over scene.json's `volume`, each holding
+// the L2 spherical-harmonic irradiance (9 RGB coefficients, Ramamoorthi & Hanrahan's cosine
+// convolution folded in) of the light arriving there from the relit environment map, with
+// parallax through the bake's gather tables (each probe direction reads the env texel that shows
+// the model point it hits). Updated every frame; evaluated at any point and normal by trilinear
+// interpolation of the coefficients. The sun is not in it: the renderer draws the sun as a
+// directional light with shadows, and keeping it out of the SH is what keeps SH9 accurate.
+//
+// Layout of coefficients() (what the renderer uploads): probe-major, then coefficient, then RGB,
+// float: value [((k·ny + j)·nx + i)·9 + c] for probe (i, j, k) and coefficient c in sh9.h's
+// order. As textures: 9 RGB32F 3D textures of nx × ny × nz texels, texture c holding
+// coefficient c. Probes sit on the volume's corners and between (ProbePosition: min + (max − min)
+// · i/(n − 1)), so a point p samples the textures at u = 0.5/n + (p − min)/(max − min) · (n − 1)/n
+// per axis, and hardware trilinear filtering is then the interpolation Irradiance() does. The irradiance is
+// E(n) = Σ_c coefficient_c · Y_c(n), no further factors.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "bake/bake.h"
+#include "scene/raycaster.h"
+
+namespace daylit::relight {
+
+class IrradianceVolume {
+ public:
+  // `inside[p]` marks probes inside the model (ProbesInsideModel): they take the mean of their
+  // valid neighbours after each update instead of the black they would see.
+  explicit IrradianceVolume(const bake::GatherTables& gather, std::vector<uint8_t> inside = {});
+
+  // Recomputes every probe from the env map's radiance (one RGB per texel, row-major, sun
+  // excluded): the gather directions carry 4π/N sr each.
+  void Update(const std::vector<glm::vec3>& env_radiance);
+
+  // Irradiance at `point` (clamped into the volume) on a surface with unit normal `normal`.
+  glm::vec3 Irradiance(const glm::vec3& point, const glm::vec3& normal) const;
+  // The same at probe (i, j, k), no interpolation.
+  glm::vec3 ProbeIrradiance(int i, int j, int k, const glm::vec3& normal) const;
+
+  const std::vector<float>& coefficients() const { return coefficients_; }
+  const bake::GatherTables& gather() const { return gather_; }
+  size_t InsideCount() const;
+
+ private:
+  const bake::GatherTables& gather_;
+  std::vector<uint8_t> inside_;
+  std::vector<float> basis_;         // [c · N + d]: Â_l · Y_c(direction d) · 4π/N
+  std::vector<float> coefficients_;  // layout above
+  std::vector<float> gathered_;      // scratch: one probe's radiances, R then G then B
+};
+
+// Probes inside the model: from inside, most gather rays leave through the back of a face; a
+// probe is inside when more than a quarter of its rays do. (A probe exactly on a surface, such
+// as the ground at the volume's floor, is not: it sees the surface as a black half.)
+std::vector<uint8_t> ProbesInsideModel(const bake::GatherTables& gather, const scene::RayCaster& caster);
+
+}  // namespace daylit::relight
