@@ -20,7 +20,7 @@ namespace daylit::bake {
 
 inline constexpr uint32_t kNoSurface = 0xFFFFFFFFu;  // sky, or no point
 // Bumped whenever the bake computes something differently, so that old caches are re-baked.
-inline constexpr const char* kBakeFormat = "daylit-bake/5";
+inline constexpr const char* kBakeFormat = "daylit-bake/6";
 
 struct BakeOptions {
   RayOptions rays;

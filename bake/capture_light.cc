@@ -173,7 +173,16 @@ SkyDistribution::SkyDistribution(const scene::HdrImage& env, const std::vector<u
 }
 
 glm::vec3 SkyDistribution::Radiance(const glm::vec3& dir, const glm::vec3& sun_dir) const {
-  return mean_.empty() ? glm::vec3(0.0f) : mean_[BinOf(dir, sun_dir)];
+  if (mean_.empty()) return glm::vec3(0.0f);
+  // Bilinear between bin centres (θ at i + 0.5°, γ at 2j + 1°): nearest bins drew rings.
+  const float theta = glm::degrees(std::acos(std::clamp(dir.z, -1.0f, 1.0f)));
+  const float gamma = glm::degrees(std::acos(std::clamp(glm::dot(dir, sun_dir), -1.0f, 1.0f)));
+  const float t = std::clamp(theta - 0.5f, 0.0f, static_cast<float>(kThetaBins - 1));
+  const float g = std::clamp(0.5f * gamma - 0.5f, 0.0f, static_cast<float>(kGammaBins - 1));
+  const int t0 = std::min(static_cast<int>(t), kThetaBins - 2), g0 = std::min(static_cast<int>(g), kGammaBins - 2);
+  const float ft = t - static_cast<float>(t0), fg = g - static_cast<float>(g0);
+  const auto at = [&](int ti, int gi) { return mean_[static_cast<size_t>(ti) * kGammaBins + static_cast<size_t>(gi)]; };
+  return (1.0f - ft) * ((1.0f - fg) * at(t0, g0) + fg * at(t0, g0 + 1)) + ft * ((1.0f - fg) * at(t0 + 1, g0) + fg * at(t0 + 1, g0 + 1));
 }
 
 glm::dvec3 SkyDistribution::HorizontalIrradiance(const glm::vec3& sun_dir) const {

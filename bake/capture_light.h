@@ -49,7 +49,7 @@ class SkyDistribution {
   SkyDistribution(const scene::HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir);
 
   bool empty() const { return mean_.empty(); }
-  // Radiance toward unit `dir` with the sun at unit `sun_dir` (nearest bin).
+  // Radiance toward unit `dir` with the sun at unit `sun_dir` (bilinear between bins).
   glm::vec3 Radiance(const glm::vec3& dir, const glm::vec3& sun_dir) const;
   // Its diffuse horizontal irradiance ∫ L cos θ dω over the upper hemisphere with the sun at
   // `sun_dir`, the number to divide by for a distribution per unit DHI.

@@ -1,12 +1,16 @@
-// The relighting stage's figures: a full irradiance-volume update for 512 probes (8×8×8, 512
-// gather directions each, a 1024×512 env map) ≤ 2 ms on one core.
+// The relighting stage's figures, one core: a full irradiance-volume update for 512 probes (8×8×8,
+// 512 gather directions each, a 1024×512 env map) ≤ 2 ms; relighting courtyard-a's 1024×512 env
+// map with a frame's light ≤ 3 ms; and the cost of a sun move for the relighter.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <random>
 
 #include "bake/sampling.h"
+#include "base/log.h"
+#include "relight/env_relight.h"
 #include "relight/irradiance_volume.h"
+#include "scene/scene.h"
 #include "scene/latlong.h"
 
 namespace daylit::relight {
@@ -46,6 +50,54 @@ void BM_VolumeUpdate512Probes(benchmark::State& state) {
   state.counters["probes"] = static_cast<double>(gather.ProbeCount());
 }
 BENCHMARK(BM_VolumeUpdate512Probes)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond);
+
+struct Courtyard {
+  scene::Scene scene = scene::LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a");
+  bake::SceneBake bake;
+  std::unique_ptr<scene::RayCaster> caster;
+  const glm::vec3 sun = glm::vec3(0.9571569f, -0.0397556f, 0.2868279f);  // burst 0 (info.json)
+
+  Courtyard() {
+    SetLogVerbosity(0);
+    bool loaded = false;
+    bake = bake::BakeOrLoad(scene, bake::BakeOptions{}, DAYLIT_BINARY_DIR "/bench-cache/courtyard-a", &loaded);
+    caster = std::make_unique<scene::RayCaster>(scene.model);
+  }
+  static Courtyard& Get() {
+    static Courtyard c;
+    return c;
+  }
+};
+
+void BM_RelightEnv(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  EnvRelighter relighter(c.bake, glm::vec3(c.scene.envmap->position), *c.caster);
+  relighter.SetSun(c.sun);
+  std::vector<glm::vec3> radiance;
+  const estimation::SunSky light{{86.3, 63.6, 37.1}, {9.9, 9.7, 10.0}};
+  for (auto _ : state) {
+    relighter.Relight(light, 0.2, &radiance);
+    benchmark::DoNotOptimize(radiance.data());
+  }
+  state.counters["texels"] = static_cast<double>(radiance.size());
+}
+BENCHMARK(BM_RelightEnv)->Unit(benchmark::kMillisecond);
+
+// A sun move: shadow rays for the 288k model texels, the transfer of the representatives (their
+// paths traced already), the sky's shape for the sky texels.
+void BM_RelightEnvSunMove(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  EnvRelighter relighter(c.bake, glm::vec3(c.scene.envmap->position), *c.caster);
+  relighter.SetSun(c.sun);
+  int k = 0;
+  for (auto _ : state) {
+    const float turn = (++k % 2 ? 0.1f : -0.1f) * 0.0175f;
+    const glm::vec3 sun(c.sun.x * std::cos(turn) - c.sun.y * std::sin(turn), c.sun.x * std::sin(turn) + c.sun.y * std::cos(turn),
+                        c.sun.z);
+    benchmark::DoNotOptimize(relighter.SetSun(sun));
+  }
+}
+BENCHMARK(BM_RelightEnvSunMove)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(4);
 
 }  // namespace
 }  // namespace daylit::relight

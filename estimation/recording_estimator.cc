@@ -166,6 +166,42 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
   return run;
 }
 
+FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, size_t position, const EstimateOptions& options) {
+  if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
+  const std::vector<capture::FrameTime>& times = scene.frame_times->frames;
+  if (position >= times.size()) {
+    ThrowInputError("{}: frame {} is past the recording's {} frames", scene.file.string(), position, times.size());
+  }
+  DecodedFrame decoded;
+  {
+    FramePipeline frames(scene);
+    for (size_t i = 0; i <= position; ++i) decoded = frames.Next();
+  }
+  FrameFit out;
+  out.row.frame = times[position].index;
+  out.row.time_utc = times[position].utc;
+  if (!decoded.ok || decoded.rgb.cols != bake.camera.width || decoded.rgb.rows != bake.camera.height) {
+    ThrowInputError("{}: frame {} cannot be decoded", scene.file.string(), out.row.frame);
+  }
+  const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(
+      times[position].utc, scene.location, sunmodel::Atmosphere::Standard(scene.location.elevation_m), {});
+  out.row.sun_elevation_deg = sun.ApparentElevationDeg();
+  out.row.sun_azimuth_deg = sun.azimuth_deg;
+  out.sun_dir = glm::vec3(scene.GeoFrame().DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg));
+  const scene::RayCaster caster(scene.model);
+  const glm::vec3 capture = scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f);
+  Sampler sampler(bake, capture, caster, options.sampler);
+  sampler.SetSun(out.sun_dir);
+  const capture::Linearizer linearizer(scene.response);
+  const std::vector<Sample> samples = sampler.Draw(decoded.rgb, times[position].exposure.value_or(scene.exposure),
+                                                   decoded.linear ? nullptr : &linearizer);
+  out.fit = FitSunSky(options.fit, samples);
+  out.row.light = out.fit.light;
+  out.row.confidence = out.fit.confidence;
+  out.row.samples = static_cast<int>(samples.size());
+  return out;
+}
+
 std::string EstimatesCsv(const std::vector<FrameEstimate>& frames) {
   fmt::memory_buffer out;
   fmt::format_to(std::back_inserter(out), "frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,"

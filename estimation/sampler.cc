@@ -15,7 +15,7 @@ namespace daylit::estimation {
 Sampler::Sampler(const bake::SceneBake& bake, const glm::vec3& capture_position, const scene::RayCaster& caster,
                  SamplerOptions options)
     : gbuffer_(bake.camera), caster_(caster), options_(options),
-      transfer_(bake, capture_position, caster, options.transfer) {
+      transfer_(bake, TransferPoints::Camera(bake.camera), capture_position, caster, options.transfer) {
   const bake::CameraGBuffer& gbuffer = bake.camera;
   for (size_t i = 0; i < gbuffer.diffuse.size(); ++i) {
     if (gbuffer.diffuse[i]) diffuse_pixels_.push_back(static_cast<uint32_t>(i));

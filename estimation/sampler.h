@@ -60,7 +60,7 @@ class Sampler {
   std::optional<glm::vec3> sun_;
   std::vector<uint8_t> sunlit_, near_boundary_;
   std::vector<float> sun_term_;  // s·max(0, n·l) per pixel
-  CameraTransfer transfer_;
+  LightTransfer transfer_;
   struct Candidate {
     uint32_t pixel;
     Transfer transfer;

@@ -3,6 +3,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
+
 #include <fmt/format.h>
 #include <glm/gtc/constants.hpp>
 #include <glm/gtx/component_wise.hpp>
@@ -36,11 +38,19 @@ bool TransferOptions::Check(std::string* why) const {
   return true;
 }
 
-CameraTransfer::CameraTransfer(const bake::SceneBake& bake, const glm::vec3& capture_position,
-                               const scene::RayCaster& caster, TransferOptions options)
-    : bake_(bake), capture_position_(capture_position), caster_(caster), options_(options),
+TransferPoints TransferPoints::Camera(const bake::CameraGBuffer& g) {
+  return {g.point.data(), g.normal.data(), g.sky_visibility.data(), g.surface.data(), g.surface.size()};
+}
+
+TransferPoints TransferPoints::Env(const bake::EnvMapMaps& env) {
+  return {env.point.data(), env.normal.data(), env.sky_visibility.data(), env.surface.data(), env.surface.size()};
+}
+
+LightTransfer::LightTransfer(const bake::SceneBake& bake, TransferPoints points, const glm::vec3& capture_position,
+                             const scene::RayCaster& caster, TransferOptions options)
+    : bake_(bake), points_(points), capture_position_(capture_position), caster_(caster), options_(options),
       hemisphere_(bake::CosineHemisphere(options.rays)),
-      slot_(bake.camera.surface.size(), -1) {
+      slot_(points.count, -1) {
   // The captured sky's shape only means something with the sun up at capture time: the (θ, γ)
   // table is relative to that sun.
   if (options.sky_distribution && bake.capture_sun.above_horizon && !bake.env.radiance.empty()) {
@@ -50,7 +60,7 @@ CameraTransfer::CameraTransfer(const bake::SceneBake& bake, const glm::vec3& cap
   }
 }
 
-void CameraTransfer::Trace(const std::vector<uint32_t>& pixels) {
+void LightTransfer::Trace(const std::vector<uint32_t>& pixels) {
   std::vector<uint32_t> fresh;
   for (const uint32_t p : pixels) {
     if (slot_[p] != -1) continue;
@@ -65,7 +75,6 @@ void CameraTransfer::Trace(const std::vector<uint32_t>& pixels) {
   };
   std::vector<Local> local(fresh.size());
   const bake::EnvMapMaps& env = bake_.env;
-  const bake::CameraGBuffer& g = bake_.camera;
   // Albedo and V of a bounce point: the env maps' where the capture point sees it; else the
   // surface's median albedo, and V marked (−1) for the cells pass below.
   const auto bounce_at = [&](const glm::vec3& y, const scene::RayHit& hit) {
@@ -87,8 +96,8 @@ void CameraTransfer::Trace(const std::vector<uint32_t>& pixels) {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, fresh.size(), kGrain), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t k = range.begin(); k != range.end(); ++k) {
       const uint32_t p = fresh[k];
-      const glm::vec3 origin = g.point[p] + options_.offset_m * g.normal[p];
-      const glm::mat3 frame = bake::HemisphereFrame(g.normal[p], p);
+      const glm::vec3 origin = points_.point[p] + options_.offset_m * points_.normal[p];
+      const glm::mat3 frame = bake::HemisphereFrame(points_.normal[p], p);
       for (const glm::vec3& d : hemisphere_) {
         const glm::vec3 dir = frame * d;
         const scene::RayHit hit = caster_.Intersect(origin, dir);
@@ -135,7 +144,7 @@ void CameraTransfer::Trace(const std::vector<uint32_t>& pixels) {
   for (size_t i = 0; i < hidden.size(); ++i) hidden[i]->sky_visibility = hidden_cells_[keys[i]];
   for (size_t k = 0; k < fresh.size(); ++k) {
     Paths paths;
-    paths.orientation = OrientationOf(g.normal[fresh[k]]);
+    paths.orientation = OrientationOf(points_.normal[fresh[k]]);
     paths.low_sky_begin = static_cast<uint32_t>(low_sky_.size());
     low_sky_.insert(low_sky_.end(), local[k].low_sky.begin(), local[k].low_sky.end());
     paths.low_sky_end = static_cast<uint32_t>(low_sky_.size());
@@ -153,7 +162,7 @@ void CameraTransfer::Trace(const std::vector<uint32_t>& pixels) {
   }
 }
 
-uint64_t CameraTransfer::CellOf(const Bounce& b) {
+uint64_t LightTransfer::CellOf(const Bounce& b) {
   const glm::ivec3 cell(glm::floor(b.point / kCellSize));
   const glm::ivec3 side(glm::round(b.normal * 8.0f));
   uint64_t key = b.surface;
@@ -162,7 +171,7 @@ uint64_t CameraTransfer::CellOf(const Bounce& b) {
   return key;
 }
 
-uint32_t CameraTransfer::OrientationOf(const glm::vec3& normal) {
+uint32_t LightTransfer::OrientationOf(const glm::vec3& normal) {
   const glm::ivec3 q(glm::round(normal * 64.0f));
   const uint64_t key = (static_cast<uint64_t>(q.x + 64) << 16) | (static_cast<uint64_t>(q.y + 64) << 8) |
                        static_cast<uint64_t>(q.z + 64);
@@ -171,7 +180,7 @@ uint32_t CameraTransfer::OrientationOf(const glm::vec3& normal) {
   return it->second;
 }
 
-std::vector<CameraTransfer::OpenSky> CameraTransfer::OpenSkyIntegrals(const glm::vec3& sun_dir,
+std::vector<LightTransfer::OpenSky> LightTransfer::OpenSkyIntegrals(const glm::vec3& sun_dir,
                                                                       const glm::vec3& inv_dhi) const {
   // Midpoint rule on a 1° × 2° grid of the upper hemisphere.
   constexpr int kRows = 90, kColumns = 180;
@@ -198,8 +207,21 @@ std::vector<CameraTransfer::OpenSky> CameraTransfer::OpenSkyIntegrals(const glm:
   return open;
 }
 
-void CameraTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct,
-                             Transfer* out) {
+std::vector<glm::vec3> LightTransfer::ClearSkyPerUnitDhi(const glm::vec3& sun_dir,
+                                                         const std::vector<glm::vec3>& dirs) const {
+  std::vector<glm::vec3> out(dirs.size(), glm::vec3(glm::one_over_pi<float>()));
+  if (sun_dir.z <= 0.0f || sky_.empty()) return out;
+  const glm::dvec3 dhi = sky_.HorizontalIrradiance(sun_dir);
+  if (!(glm::compMin(dhi) > 0.0)) return out;
+  const glm::vec3 inv_dhi(1.0 / dhi);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, dirs.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) out[i] = sky_.Radiance(dirs[i], sun_dir) * inv_dhi;
+  });
+  return out;
+}
+
+void LightTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct,
+                            Transfer* out, Transfer* reflected_out) {
   Trace(pixels);
   const bool day = sun_dir.z > 0.0f;
   glm::vec3 inv_dhi(0.0f);  // of the clear sky under this sun
@@ -215,7 +237,6 @@ void CameraTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec
     return open[o].uniform > 1e-3f ? open[o].clear / open[o].uniform : glm::vec3(1.0f);
   };
   const float inv_rays = 1.0f / static_cast<float>(hemisphere_.size());
-  const bake::CameraGBuffer& g = bake_.camera;
   // First bounce: direct light at each bounce point. `reflected` keeps it apart from the direct
   // terms for the per-surface means of the second.
   std::vector<Transfer> reflected(pixels.size());
@@ -236,7 +257,7 @@ void CameraTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec
       // the open hemisphere would give (exact) less what the model blocks above the horizon, plus
       // what escapes below it: only the blocked part is sampled, which keeps the noise of a sky
       // ten times brighter at the horizon than at the zenith off open points.
-      const float v = g.sky_visibility[p];
+      const float v = points_.sky_visibility[p];
       t.sun = glm::vec3(day ? direct[p] : 0.0f);
       t.overcast = glm::vec3(v);
       t.clear = glm::vec3(v);
@@ -251,7 +272,10 @@ void CameraTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec
       reflected[k] = r;
     }
   });
-  if (!options_.interreflection) return;
+  if (!options_.interreflection) {
+    if (reflected_out != nullptr) std::fill(reflected_out, reflected_out + pixels.size(), Transfer{});
+    return;
+  }
   // Further bounces: each bounce point's own reflected light, as its surface's mean over these
   // pixels (surfaces without pixels here take the mean of all), iterated: the first pass gives the
   // second bounce, the next the third.
@@ -261,7 +285,7 @@ void CameraTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec
     std::vector<Transfer> mean(surfaces + 1);
     std::vector<double> count(surfaces + 1, 0.0);
     for (size_t k = 0; k < pixels.size(); ++k) {
-      for (const size_t s : {std::min<size_t>(g.surface[pixels[k]], surfaces), surfaces}) {
+      for (const size_t s : {std::min<size_t>(points_.surface[pixels[k]], surfaces), surfaces}) {
         mean[s].sun += indirect[k].sun, mean[s].clear += indirect[k].clear, mean[s].overcast += indirect[k].overcast;
         count[s] += 1.0;
       }
@@ -287,6 +311,7 @@ void CameraTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec
   }
   for (size_t k = 0; k < pixels.size(); ++k) {
     out[k].sun += indirect[k].sun, out[k].clear += indirect[k].clear, out[k].overcast += indirect[k].overcast;
+    if (reflected_out != nullptr) reflected_out[k] = indirect[k];
   }
 }
 

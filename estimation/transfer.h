@@ -1,4 +1,4 @@
-// Light transport at camera pixels that stays linear in the light: the "precomputed per-point
+// Light transport at points of the model (camera pixels, env-map texels) that stays linear in the light: the "precomputed per-point
 // terms" of docs/design.md that take the model beyond seed 001. Per colour channel,
 //
 //   L(x) = ρ/π · ( E_sun · T_sun(x) + E_clear · T_clear(x) + E_overcast · T_overcast(x) )
@@ -47,6 +47,18 @@ struct TransferOptions {
   bool Check(std::string* why) const;
 };
 
+// The points a LightTransfer works on: what the bake knows of each (arrays of `count`).
+struct TransferPoints {
+  const glm::vec3* point = nullptr;
+  const glm::vec3* normal = nullptr;  // unit, facing the side that is seen
+  const float* sky_visibility = nullptr;
+  const uint32_t* surface = nullptr;
+  size_t count = 0;
+
+  static TransferPoints Camera(const bake::CameraGBuffer& g);  // the G-buffer's pixels
+  static TransferPoints Env(const bake::EnvMapMaps& env);      // the env map's texels
+};
+
 // Irradiance at a point per unit DNI (sun) and per unit DHI of each sky, RGB (reflected light
 // takes the colour of the surfaces it comes from).
 struct Transfer {
@@ -55,19 +67,26 @@ struct Transfer {
   glm::vec3 overcast{0.0f};  // uniform sky
 };
 
-class CameraTransfer {
+class LightTransfer {
  public:
-  // `bake`: G-buffer points, normals and V, the env maps (albedo and V of bounce points the
-  // capture point sees), the per-surface albedo (those it does not) and the captured sky.
-  // `capture_position`: scene.envmap.position. Both `bake` and `caster` must outlive this.
-  CameraTransfer(const bake::SceneBake& bake, const glm::vec3& capture_position, const scene::RayCaster& caster,
-                 TransferOptions options = {});
+  // `points`: where (indices into it name points below). `bake`: the env maps (albedo and V of
+  // bounce points the capture point sees), the per-surface albedo (those it does not) and the
+  // captured sky. `capture_position`: scene.envmap.position. `bake`, the arrays behind `points`
+  // and `caster` must outlive this.
+  LightTransfer(const bake::SceneBake& bake, TransferPoints points, const glm::vec3& capture_position,
+                const scene::RayCaster& caster, TransferOptions options = {});
 
-  // T of the G-buffer pixels `pixels` under the unit sun `sun_dir` (z ≤ 0: below the horizon,
-  // T_sun = 0 and both skies are taken as uniform). `direct[p]` is s·max(0, n·l) of G-buffer pixel p.
-  // Traces the paths of pixels seen for the first time (in parallel), then evaluates all of
-  // them (in parallel). out[k] is the transfer of pixels[k].
-  void Compute(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct, Transfer* out);
+  // T of the points `pixels` under the unit sun `sun_dir` (z ≤ 0: below the horizon, T_sun = 0
+  // and both skies are taken as uniform). `direct[p]` is s·max(0, n·l) of point p. Traces the
+  // paths of points seen for the first time (in parallel), then evaluates all of them (in
+  // parallel). out[k] is the transfer of pixels[k]; `reflected`, if given, receives the part of
+  // it that the model reflects (T less the direct sun and sky).
+  void Compute(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct, Transfer* out,
+               Transfer* reflected = nullptr);
+
+  // The clear sky's radiance per unit DHI toward each of `dirs` under the unit sun `sun_dir`;
+  // 1/π (a uniform sky) without a captured sky or with the sun down.
+  std::vector<glm::vec3> ClearSkyPerUnitDhi(const glm::vec3& sun_dir, const std::vector<glm::vec3>& dirs) const;
 
   size_t TracedPixels() const { return paths_.size(); }
   // Whether T_clear differs from T_overcast: a captured sky with the sun up.
@@ -100,6 +119,7 @@ class CameraTransfer {
   std::vector<OpenSky> OpenSkyIntegrals(const glm::vec3& sun_dir, const glm::vec3& inv_dhi) const;
 
   const bake::SceneBake& bake_;
+  TransferPoints points_;
   glm::vec3 capture_position_;
   const scene::RayCaster& caster_;
   TransferOptions options_;

@@ -59,7 +59,7 @@ TEST(TransferTest, OneBounceOffASunlitWallMatchesItsViewFactor) {
   options.rays = 1024;
   options.hidden_sky_rays = 256;
   options.bounces = 1;  // the analytic figure is for one bounce
-  CameraTransfer transfer(w.bake, glm::vec3(w.scene.envmap->position), *w.caster, options);
+  LightTransfer transfer(w.bake, TransferPoints::Camera(w.bake.camera), glm::vec3(w.scene.envmap->position), *w.caster, options);
   // The sun 45° high behind the camera lights the ground and the wall's face toward it.
   const glm::vec3 sun = glm::normalize(glm::vec3(-1.0f, 0.0f, 1.0f));
   const float cos45 = std::sqrt(0.5f);
@@ -88,7 +88,7 @@ TEST(TransferTest, OneBounceOffASunlitWallMatchesItsViewFactor) {
 
   // Without interreflection the terms are seed 001's: s·max(0, n·l) and V.
   options.interreflection = false;
-  CameraTransfer plain(w.bake, glm::vec3(w.scene.envmap->position), *w.caster, options);
+  LightTransfer plain(w.bake, TransferPoints::Camera(w.bake.camera), glm::vec3(w.scene.envmap->position), *w.caster, options);
   plain.Compute(ground, sun, direct.data(), t.data());
   for (size_t k = 0; k < ground.size(); ++k) {
     EXPECT_EQ(t[k].sun, glm::vec3(cos45));
@@ -106,7 +106,7 @@ TEST(TransferTest, AWallSeesTheSkyInItsDistribution) {
   TransferOptions options;
   options.rays = 1024;
   options.interreflection = false;
-  CameraTransfer transfer(w.bake, glm::vec3(w.scene.envmap->position), *w.caster, options);
+  LightTransfer transfer(w.bake, TransferPoints::Camera(w.bake.camera), glm::vec3(w.scene.envmap->position), *w.caster, options);
   const std::vector<uint32_t> wall = w.PixelsOf(1);
   ASSERT_GT(wall.size(), 100u);
   const std::vector<float> direct(w.bake.camera.surface.size(), 0.0f);

@@ -283,6 +283,8 @@ VolumeSpec DefaultVolume(const std::vector<VirtualObject>& objects) {
   return v;
 }
 
+constexpr long long kMaxProbes = 32768;
+
 void LoadVolume(const JsonField& root, Scene* scene) {
   const std::optional<JsonField> volume = root.Find("volume");
   if (!volume) {
@@ -302,6 +304,22 @@ void LoadVolume(const JsonField& root, Scene* scene) {
     if (v.resolution[a] < 1 || v.resolution[a] > 256) {
       r[static_cast<size_t>(a)].Fail(fmt::format("{} is outside [1, 256]", v.resolution[a]));
     }
+  }
+  // Each probe gathers 512 rays in the bake and 512 texels every frame.
+  const long long probes = static_cast<long long>(v.resolution.x) * v.resolution.y * v.resolution.z;
+  if (probes > kMaxProbes) {
+    resolution.Fail(fmt::format("{}×{}×{} = {} probes; at most {}", v.resolution.x, v.resolution.y, v.resolution.z,
+                                probes, kMaxProbes));
+  }
+  // Objects placed where the model is not get light the model cannot know (no walls, no ground
+  // to shade or reflect): allowed, but said.
+  glm::vec3 lo, hi;
+  scene->model.Bounds(&lo, &hi);
+  if (glm::any(glm::greaterThan(glm::vec3(v.min), hi)) || glm::any(glm::lessThan(glm::vec3(v.max), lo))) {
+    Log().warn("{}: volume: the box ({}, {}, {})-({}, {}, {}) lies outside the model's bounds ({:.2f}, {:.2f}, "
+               "{:.2f})-({:.2f}, {:.2f}, {:.2f}); its probes see no model around them",
+               scene->file.string(), v.min.x, v.min.y, v.min.z, v.max.x, v.max.y, v.max.z, lo.x, lo.y, lo.z, hi.x,
+               hi.y, hi.z);
   }
   scene->volume = v;
 }

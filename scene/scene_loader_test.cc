@@ -178,6 +178,10 @@ const BadScene kBadScenes[] = {
      "objects[1].mesh: 'builtin:cone' is not a builtin"},
     {"volume inverted", [](auto& j, auto&) { j["volume"]["max"][2] = -1; },
      "volume.max: must exceed min on every axis"},
+    {"volume with no probes", [](auto& j, auto&) { j["volume"]["resolution"][1] = 0; },
+     "volume.resolution[1]: 0 is outside [1, 256]"},
+    {"volume with too many probes", [](auto& j, auto&) { j["volume"]["resolution"] = {64, 64, 64}; },
+     "volume.resolution: 64×64×64 = 262144 probes; at most 32768"},
     {"too few correspondences", [](auto& j, auto&) {
        j["camera"]["correspondences"] = {{{"world", {0, 0, 0}}, {"pixel", {1, 2}}}};
      }, "camera.correspondences: at least 4 correspondences are needed, got 1"},

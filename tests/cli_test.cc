@@ -187,6 +187,15 @@ TEST(CliTest, EstimateSkipsAFrameThatCannotBeDecodedAndGoesOn) {
   EXPECT_EQ(table.rows[2][7], table.rows[0][7]);
 }
 
+TEST(CliTest, AVolumeOutsideTheModelIsAWarning) {
+  scene::testing::SceneSandbox sandbox("cli_volume");
+  sandbox.json()["volume"] = {{"min", {5000, 5000, 0}}, {"max", {5001, 5001, 1}}, {"resolution", {2, 2, 2}}};
+  const CliRun run = Daylit("info " + sandbox.Write().string());
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("volume: the box (5000, 5000, 0)-(5001, 5001, 1) lies outside the model's bounds"), std::string::npos)
+      << run.err << run.out;
+}
+
 struct BadCall {
   std::string args;
   std::string error;  // expected on stderr

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "bake/bake.h"
+#include "tests/courtyard_fixture.h"
 #include "base/log.h"
 #include "estimation/recording_estimator.h"
 #include "scene/scene.h"
@@ -15,11 +16,8 @@ namespace daylit {
 namespace {
 
 TEST(EstimateRecordingTest, CourtyardLightingWithin5PercentOfTheTruth) {
-  SetLogVerbosity(0);
-  const scene::Scene scene = scene::LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a");
-  bool loaded = false;
-  const bake::SceneBake baked =
-      bake::BakeOrLoad(scene, bake::BakeOptions{}, DAYLIT_BINARY_DIR "/test-cache/courtyard-a", &loaded);
+  const scene::Scene& scene = testing::Courtyard().scene;
+  const bake::SceneBake& baked = testing::Courtyard().bake;
   const estimation::EstimateRun run = estimation::EstimateRecording(scene, baked, {});
   ASSERT_EQ(run.frames.size(), 600u);
   EXPECT_EQ(run.undecodable, 0);

@@ -13,6 +13,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include "bake/bake.h"
+#include "tests/courtyard_fixture.h"
 #include "bake/sampling.h"
 #include "base/log.h"
 #include "relight/irradiance_volume.h"
@@ -23,11 +24,8 @@ namespace daylit {
 namespace {
 
 TEST(VolumeRecordingTest, CourtyardVolumeMatchesBruteForceIrradiance) {
-  SetLogVerbosity(0);
-  const scene::Scene scene = scene::LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a");
-  bool loaded = false;
-  const bake::SceneBake baked =
-      bake::BakeOrLoad(scene, bake::BakeOptions{}, DAYLIT_BINARY_DIR "/test-cache/courtyard-a", &loaded);
+  const scene::Scene& scene = testing::Courtyard().scene;
+  const bake::SceneBake& baked = testing::Courtyard().bake;
   const scene::RayCaster caster(scene.model);
   relight::IrradianceVolume volume(baked.gather, relight::ProbesInsideModel(baked.gather, caster));
   volume.Update(baked.env.radiance);

@@ -10,5 +10,6 @@ void AddSunposCommand(CLI::App& app);
 void AddInfoCommand(CLI::App& app);
 void AddBakeCommand(CLI::App& app);
 void AddEstimateCommand(CLI::App& app);
+void AddRelightEnvCommand(CLI::App& app);
 
 }  // namespace daylit::app

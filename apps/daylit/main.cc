@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   daylit::app::AddInfoCommand(app);
   daylit::app::AddBakeCommand(app);
   daylit::app::AddEstimateCommand(app);
+  daylit::app::AddRelightEnvCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,216 @@
+#include "relight/env_relight.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/constants.hpp>
+#include <glm/gtx/component_wise.hpp>
+#include <opencv2/core.hpp>
+
+#include "bake/surface_light.h"
+#include "report/plot.h"
+#include "scene/latlong.h"
+
+namespace daylit::relight {
+
+EnvRelighter::EnvRelighter(const bake::SceneBake& bake, const glm::vec3& capture_position,
+                           const scene::RayCaster& caster, estimation::TransferOptions options)
+    : bake_(bake), caster_(caster),
+      transfer_(bake, estimation::TransferPoints::Env(bake.env), capture_position, caster, options) {
+  const bake::EnvMapMaps& env = bake.env;
+  const int w = env.width, h = env.height;
+  std::vector<uint8_t> chosen(env.surface.size(), 0);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const uint32_t t = static_cast<uint32_t>(v) * static_cast<uint32_t>(w) + static_cast<uint32_t>(u);
+      if (env.IsSky(t)) continue;
+      model_texels_.push_back(t);
+      // The nearest corner of its 4×4 block (the map wraps around horizontally) on the same
+      // surface, else the texel itself.
+      const int u0 = u - u % 4, v0 = v - v % 4;
+      uint32_t rep = t;
+      for (const glm::ivec2& c : {glm::ivec2(u0, v0), glm::ivec2(u0 + 4, v0), glm::ivec2(u0, v0 + 4), glm::ivec2(u0 + 4, v0 + 4)}) {
+        if (c.y >= h) continue;
+        const uint32_t ct = static_cast<uint32_t>(c.y) * static_cast<uint32_t>(w) + static_cast<uint32_t>(c.x % w);
+        if (env.surface[ct] == env.surface[t]) {
+          rep = ct;
+          break;
+        }
+      }
+      representative_.push_back(rep);
+      if (!chosen[rep]) chosen[rep] = 1, traced_.push_back(rep);
+    }
+  }
+  terms_.resize(model_texels_.size());
+}
+
+bool EnvRelighter::SetSun(const glm::vec3& sun_dir) {
+  if (sun_ && glm::degrees(std::acos(std::clamp(glm::dot(*sun_, sun_dir), -1.0f, 1.0f))) <= 0.05f) return false;
+  sun_ = sun_dir;
+  const bake::EnvMapMaps& env = bake_.env;
+  // The direct sun at every model texel.
+  std::vector<glm::vec3> points(model_texels_.size()), normals(model_texels_.size());
+  for (size_t i = 0; i < model_texels_.size(); ++i) points[i] = env.point[model_texels_[i]], normals[i] = env.normal[model_texels_[i]];
+  std::vector<uint8_t> lit(model_texels_.size(), 0);
+  if (sun_dir.z > 0.0f) bake::SunVisibility(caster_, points.data(), normals.data(), points.size(), sun_dir, 2e-3f, lit.data());
+  std::vector<float> direct(env.surface.size(), 0.0f);
+  for (size_t i = 0; i < model_texels_.size(); ++i) {
+    direct[model_texels_[i]] = lit[i] ? std::max(0.0f, glm::dot(normals[i], sun_dir)) : 0.0f;
+  }
+  // Transfer of the representatives, then every texel: its own direct terms, its
+  // representative's reflected light (and, for the clear sky, its shape of what V lets through).
+  std::vector<estimation::Transfer> total(traced_.size()), reflected(traced_.size());
+  transfer_.Compute(traced_, sun_dir, direct.data(), total.data(), reflected.data());
+  std::vector<int32_t> index_of(env.surface.size(), -1);
+  for (size_t k = 0; k < traced_.size(); ++k) index_of[traced_[k]] = static_cast<int32_t>(k);
+  for (size_t i = 0; i < model_texels_.size(); ++i) {
+    const uint32_t t = model_texels_[i], rep = representative_[i];
+    const size_t k = static_cast<size_t>(index_of[rep]);
+    const estimation::Transfer& r = reflected[k];
+    if (rep == t) {
+      terms_[i] = total[k];
+      continue;
+    }
+    const float v = env.sky_visibility[t], v_rep = env.sky_visibility[rep];
+    const glm::vec3 clear_direct = total[k].clear - r.clear;
+    terms_[i].sun = glm::vec3(direct[t]) + r.sun;
+    terms_[i].overcast = glm::vec3(v) + r.overcast;
+    terms_[i].clear = (v_rep > 0.01f ? clear_direct * (v / v_rep) : glm::vec3(v)) + r.clear;
+  }
+  // The sky's shape per sky texel.
+  std::vector<glm::vec3> dirs;
+  std::vector<uint32_t> sky_texels;
+  for (int v = 0; v < env.height; ++v) {
+    for (int u = 0; u < env.width; ++u) {
+      const uint32_t t = static_cast<uint32_t>(v) * static_cast<uint32_t>(env.width) + static_cast<uint32_t>(u);
+      if (!env.IsSky(t)) continue;
+      sky_texels.push_back(t);
+      dirs.push_back(glm::vec3(scene::LatLongDirection(u, v, env.width, env.height)));
+    }
+  }
+  const std::vector<glm::vec3> shape = transfer_.ClearSkyPerUnitDhi(sun_dir, dirs);
+  sky_shape_.assign(env.surface.size(), glm::vec3(0.0f));
+  for (size_t i = 0; i < sky_texels.size(); ++i) sky_shape_[sky_texels[i]] = shape[i];
+  return true;
+}
+
+void EnvRelighter::Relight(const estimation::SunSky& light, double overcast_share,
+                           std::vector<glm::vec3>* radiance) const {
+  const bake::EnvMapMaps& env = bake_.env;
+  radiance->resize(env.surface.size());
+  const glm::vec3 sun(light.sun_rgb), sky(light.sky_rgb);
+  const float o = static_cast<float>(std::clamp(overcast_share, 0.0, 1.0));
+  const glm::vec3 clear_sky = (1.0f - o) * sky, overcast_sky = o * sky;
+  // Sky texels first (model texels overwrite theirs below).
+  const glm::vec3 uniform = overcast_sky * glm::one_over_pi<float>();
+  for (size_t t = 0; t < sky_shape_.size(); ++t) (*radiance)[t] = clear_sky * sky_shape_[t] + uniform;
+  for (size_t i = 0; i < model_texels_.size(); ++i) {
+    const estimation::Transfer& T = terms_[i];
+    const uint32_t t = model_texels_[i];
+    (*radiance)[t] = env.albedo[t] * glm::one_over_pi<float>() * (sun * T.sun + clear_sky * T.clear + overcast_sky * T.overcast);
+  }
+}
+
+namespace {
+
+float Luminance(const glm::vec3& l) { return 0.2126f * l.x + 0.7152f * l.y + 0.0722f * l.z; }
+
+// The 99th percentile of `luminance` (reordered), the white of a preview.
+float WhiteOf(std::vector<float>& luminance) {
+  const size_t k = luminance.size() * 99 / 100;
+  std::nth_element(luminance.begin(), luminance.begin() + static_cast<ptrdiff_t>(k), luminance.end());
+  return std::max(luminance[k], 1e-6f);
+}
+
+// `radiance` / `white`, clamped, sRGB-encoded, as an 8-bit BGR image.
+cv::Mat Preview(int width, int height, const std::vector<glm::vec3>& radiance, float white) {
+  cv::Mat preview(height, width, CV_8UC3);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const glm::vec3 l = glm::clamp(radiance[static_cast<size_t>(v) * width + u] / white, 0.0f, 1.0f);
+      cv::Vec3b& p = preview.at<cv::Vec3b>(v, u);
+      for (int c = 0; c < 3; ++c) {
+        const float e = l[c] <= 0.0031308f ? 12.92f * l[c] : 1.055f * std::pow(l[c], 1.0f / 2.4f) - 0.055f;
+        p[2 - c] = static_cast<uint8_t>(std::lround(255.0f * e));
+      }
+    }
+  }
+  return preview;
+}
+
+std::vector<glm::vec3> RadianceOf(const scene::HdrImage& image) {
+  std::vector<glm::vec3> out(static_cast<size_t>(image.width) * image.height);
+  for (size_t i = 0; i < out.size(); ++i) out[i] = glm::vec3(image.rgb[3 * i], image.rgb[3 * i + 1], image.rgb[3 * i + 2]);
+  return out;
+}
+
+}  // namespace
+
+EnvComparison CompareEnvMaps(const bake::EnvMapMaps& env, const std::vector<glm::vec3>& relit,
+                             const scene::HdrImage& truth) {
+  const std::vector<glm::vec3> want = RadianceOf(truth);
+  std::vector<float> luminance;
+  for (size_t t = 0; t < want.size(); ++t) {
+    if (!env.IsSky(t)) luminance.push_back(Luminance(want[t]));
+  }
+  std::nth_element(luminance.begin(), luminance.begin() + static_cast<ptrdiff_t>(luminance.size() / 2), luminance.end());
+  const float floor = luminance.empty() ? 0.0f : 1e-3f * luminance[luminance.size() / 2];
+  EnvComparison cmp;
+  double sum = 0.0;
+  for (int v = 0; v < env.height; ++v) {
+    const double solid_angle = scene::LatLongTexelSolidAngle(v, env.width, env.height);
+    for (int u = 0; u < env.width; ++u) {
+      const size_t t = static_cast<size_t>(v) * env.width + u;
+      if (env.IsSky(t)) {
+        const double cos_theta = scene::LatLongDirection(u, v, env.width, env.height).z;
+        if (cos_theta <= 0.0) continue;
+        cmp.sky_dhi += solid_angle * cos_theta * Luminance(relit[t]);
+        cmp.true_sky_dhi += solid_angle * cos_theta * Luminance(want[t]);
+        continue;
+      }
+      if (Luminance(want[t]) < floor || glm::compMin(want[t]) <= 0.0f) continue;
+      const glm::vec3 e = glm::abs(relit[t] - want[t]) / want[t];
+      sum += (e.x + e.y + e.z) / 3.0;
+      ++cmp.surface_texels;
+    }
+  }
+  cmp.surface_error = cmp.surface_texels > 0 ? sum / static_cast<double>(cmp.surface_texels) : 0.0;
+  return cmp;
+}
+
+void WriteEnvComparison(const std::filesystem::path& png, const bake::EnvMapMaps& env,
+                        const std::vector<glm::vec3>& relit, const scene::HdrImage& truth) {
+  const int w = env.width, h = env.height;
+  const std::vector<glm::vec3> want = RadianceOf(truth);
+  std::vector<float> luminance(want.size());
+  for (size_t t = 0; t < want.size(); ++t) luminance[t] = Luminance(want[t]);
+  const float white = WhiteOf(luminance);  // one exposure for both maps
+  cv::Mat difference(h, w, CV_8UC3);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const size_t t = static_cast<size_t>(v) * w + u;
+      const float lw = Luminance(want[t]);
+      const float d = lw > 0.0f ? std::clamp((Luminance(relit[t]) - lw) / lw / 0.25f, -1.0f, 1.0f) : 0.0f;
+      const auto level = [](float x) { return static_cast<uint8_t>(std::lround(255.0f * (1.0f - x))); };
+      difference.at<cv::Vec3b>(v, u) = d >= 0.0f ? cv::Vec3b(level(d), level(d), 255) : cv::Vec3b(255, level(-d), level(-d));
+    }
+  }
+  report::WritePng(png, {Preview(w, h, want, white), Preview(w, h, relit, white), difference});
+}
+
+void WriteEnvMap(const std::filesystem::path& exr, int width, int height, const std::vector<glm::vec3>& radiance) {
+  const size_t n = static_cast<size_t>(width) * height;
+  std::vector<float> r(n), g(n), b(n), luminance(n);
+  for (size_t i = 0; i < n; ++i) {
+    r[i] = radiance[i].x, g[i] = radiance[i].y, b[i] = radiance[i].z;
+    luminance[i] = Luminance(radiance[i]);
+  }
+  scene::WriteExr(exr, width, height,
+                  {{"R", scene::ExrPixelType::kFloat, r.data(), nullptr},
+                   {"G", scene::ExrPixelType::kFloat, g.data(), nullptr},
+                   {"B", scene::ExrPixelType::kFloat, b.data(), nullptr}});
+  std::filesystem::path png = exr;
+  report::WritePng(png.replace_extension(".png"), {Preview(width, height, radiance, WhiteOf(luminance))});
+}
+
+}  // namespace daylit::relight
