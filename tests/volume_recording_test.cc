@@ -2,9 +2,9 @@
 // probes, 256 gather directions) against brute-force ray-traced irradiance from the same env map
 // (Embree, 2048 cosine-weighted rays, the same parallax rule: a ray that hits the model reads the
 // texel that shows the hit point from the capture position) at 1000 random points and normals
-// inside the volume: mean relative error ≤ 3%, 95th percentile ≤ 10%. The env map is the
-// captured one with the sun disc removed (the bake's), standing in for a relit one: the volume
-// does not care where the radiance comes from.
+// inside the volume: mean relative error ≤ 3%, 95th percentile ≤ 10%. The env map is the one
+// daylit relights for frame 550 (clear, the sun 30° high in the west) with the light it fits
+// there.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,6 +16,8 @@
 #include "tests/courtyard_fixture.h"
 #include "bake/sampling.h"
 #include "base/log.h"
+#include "estimation/recording_estimator.h"
+#include "relight/env_relight.h"
 #include "relight/irradiance_volume.h"
 #include "scene/latlong.h"
 #include "scene/scene.h"
@@ -27,8 +29,13 @@ TEST(VolumeRecordingTest, CourtyardVolumeMatchesBruteForceIrradiance) {
   const scene::Scene& scene = testing::Courtyard().scene;
   const bake::SceneBake& baked = testing::Courtyard().bake;
   const scene::RayCaster caster(scene.model);
+  const estimation::FrameFit fit = estimation::FitFrame(scene, baked, 550, {});
+  relight::EnvRelighter relighter(baked, glm::vec3(scene.envmap->position), caster);
+  relighter.SetSun(fit.sun_dir);
+  std::vector<glm::vec3> env;
+  relighter.Relight(fit.fit.light, fit.fit.overcast_share, &env);
   relight::IrradianceVolume volume(baked.gather, relight::ProbesInsideModel(baked.gather, caster));
-  volume.Update(baked.env.radiance);
+  volume.Update(env);
   const glm::vec3 capture(scene.envmap->position);
   const int w = baked.env.width, h = baked.env.height;
   const std::vector<glm::vec3> hemisphere = bake::CosineHemisphere(2048);
@@ -55,7 +62,7 @@ TEST(VolumeRecordingTest, CourtyardVolumeMatchesBruteForceIrradiance) {
       const glm::vec3 dir = frame * local;
       const scene::RayHit hit = caster.Intersect(p, dir);
       const glm::dvec3 toward = hit.IsHit() ? glm::dvec3(p + hit.t * dir - capture) : glm::dvec3(dir);
-      sum += glm::dvec3(baked.env.radiance[static_cast<size_t>(scene::LatLongTexel(toward, w, h))]);
+      sum += glm::dvec3(env[static_cast<size_t>(scene::LatLongTexel(toward, w, h))]);
     }
     const glm::dvec3 truth = glm::pi<double>() * sum / static_cast<double>(hemisphere.size());
     const glm::dvec3 got(volume.Irradiance(p, n));
