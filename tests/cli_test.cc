@@ -15,6 +15,7 @@
 #include "capture/response.h"
 #include "base/atomic_file.h"
 #include "base/csv.h"
+#include "scene/hdr_image.h"
 #include "scene/scene_test_util.h"
 
 namespace daylit {
@@ -187,6 +188,23 @@ TEST(CliTest, EstimateSkipsAFrameThatCannotBeDecodedAndGoesOn) {
   EXPECT_EQ(table.rows[2][7], table.rows[0][7]);
 }
 
+TEST(CliTest, RelightEnvWritesTheRelitMapAndItsPreview) {
+  // Night, one grey frame (code 120) of open ground of albedo 0.4: the fit gives E_sky = π·L/0.4
+  // (see EstimateWritesTheStableCsv), so the relit sky has radiance E_sky/π = L/0.4 everywhere
+  // (a uniform sky with the sun down) and the ground 0.4/π · E_sky · V = L.
+  bake::testing::SyntheticRecording rec("cli_relight_env");
+  const std::string scene = rec.Write().string();
+  const fs::path out = rec.dir / "env.exr";
+  const CliRun run = Daylit("relight-env " + scene + " --frame 0 --cache " + (rec.dir / "cache").string() +
+                            " --out " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_TRUE(fs::is_regular_file(rec.dir / "env.png"));
+  const scene::HdrImage env = scene::ReadHdrImage(out);
+  const float linear = static_cast<float>(capture::CameraResponse{}.ToLinear(120.0 / 255.0));
+  EXPECT_NEAR(env.Pixel(0, 0)[1], linear / 0.4f, 0.01f * linear / 0.4f);                   // zenith
+  EXPECT_NEAR(env.Pixel(10, env.height - 1)[1], linear, 0.02f * linear);                     // ground below
+}
+
 TEST(CliTest, AVolumeOutsideTheModelIsAWarning) {
   scene::testing::SceneSandbox sandbox("cli_volume");
   sandbox.json()["volume"] = {{"min", {5000, 5000, 0}}, {"max", {5001, 5001, 1}}, {"resolution", {2, 2, 2}}};
@@ -217,6 +235,8 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"sunpos --time 2026-06-21T10:00:00Z --lat 57", "--lat and --lon are required"},
       {"sunpos --csv /no/such.csv", "/no/such.csv: cannot open"},
       {"sunpos --frobnicate", "frobnicate"},
+      {"relight-env " + std::string(DAYLIT_SOURCE_DIR) + "/recordings/courtyard-a --frame 99999",
+       "--frame: 99999 is not in"},
   };
   for (const BadCall& call : calls) {
     const CliRun run = Daylit(call.args);  // NOLINT
