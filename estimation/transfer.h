@@ -1,5 +1,6 @@
-// Light transport at points of the model (camera pixels, env-map texels) that stays linear in the light: the "precomputed per-point
-// terms" of docs/design.md that take the model beyond seed 001. Per colour channel,
+// Light transport at points of the model (camera pixels, env-map texels) that stays linear in
+// the light: the "precomputed per-point terms" of docs/design.md that take the model beyond
+// seed 001. Per colour channel,
 //
 //   L(x) = ρ/π · ( E_sun · T_sun(x) + E_clear · T_clear(x) + E_overcast · T_overcast(x) )
 //
@@ -13,14 +14,15 @@
 //
 // where the integrals run over x's hemisphere and y is the model point a direction ω hits. At y,
 // the direct terms are exact (s_y·max(0, n_y·l) by a shadow ray; V_y, times the clear sky's weight
-// for y's orientation) and y's own reflected light is its surface's mean over the traced pixels,
-// iterated for a third bounce (each bounce off walls of albedo ~0.3-0.5 adds a few percent more). With a uniform sky and no reflection, T_sun = s·max(0, n·l)
-// and T_clear = T_overcast = V: the model of seed 001. The reflected terms are what a courtyard
-// adds: shadowed ground lit by sunlit walls, warm where the walls are red.
+// for y's orientation) and y's own reflected light is its surface's mean over the traced points,
+// iterated for a third bounce (each bounce off walls of albedo ~0.3-0.5 adds a few percent
+// more). With a uniform sky and no reflection, T_sun = s·max(0, n·l) and T_clear = T_overcast = V:
+// the model of seed 001. The reflected terms are what a courtyard adds: shadowed ground lit by
+// sunlit walls, warm where the walls are red.
 //
 // The paths (which directions reach the sky, which model points the rays hit, and their ρ_y and
-// V_y) do not depend on the sun, so they are traced once per pixel and kept; a new sun costs one
-// shadow ray per bounce point and a table lookup per sky direction.
+// V_y) do not depend on the sun, so they are traced once per point and kept; a new sun costs one
+// shadow ray per bounce point and a table lookup per blocked or low sky direction.
 #pragma once
 
 #include <cstdint>
@@ -37,7 +39,7 @@
 namespace daylit::estimation {
 
 struct TransferOptions {
-  int rays = 256;               // cosine-weighted hemisphere rays per pixel
+  int rays = 256;               // cosine-weighted hemisphere rays per point
   int hidden_sky_rays = 64;     // rays for V_y of bounce points the capture point does not see (per cell)
   float offset_m = 2e-3f;       // ray origins are moved this far along the normal
   bool interreflection = true;  // the reflected terms
