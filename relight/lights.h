@@ -1,0 +1,47 @@
+// An environment map approximated by an ambient term plus N directional lights (seeds 000 and
+// 002), so that diffuse shading by the lights matches image-based lighting:
+//
+//   E(n) = ambient + Σ_i irradiance_i · max(0, n · direction_i)
+//
+// `irradiance_i` is light i's contribution on a surface facing it; `ambient` the constant
+// irradiance it adds to every normal. Directions are unit vectors in the map's frame
+// (docs/design.md's lat-long convention).
+#pragma once
+
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/hdr_image.h"
+
+namespace daylit::relight {
+
+struct DirectionalLight {
+  glm::vec3 direction{0.0f, 0.0f, 1.0f};
+  glm::vec3 irradiance{0.0f};
+};
+
+struct LightSet {
+  glm::vec3 ambient{0.0f};
+  std::vector<DirectionalLight> lights;
+
+  glm::dvec3 Irradiance(const glm::vec3& normal) const;
+};
+
+// Debevec's Median Cut (seed 002 §4.1): the map, weighted by texel solid angle, is split
+// `levels` times, each region along its longer side (width measured at its middle latitude) where
+// the luminance on both sides is equal; each of the 2^levels regions becomes one light at its
+// luminance-weighted centroid direction carrying the region's whole power Σ L·ΔΩ (RGB). No ambient.
+LightSet MedianCut(const scene::HdrImage& map, int levels);
+
+// Seed 002's measure over a set of normals: the per-normal relative error |E − E_true| / E_true,
+// averaged over RGB; its mean and max over the normals whose true irradiance is at least 1e-3 of
+// the maximum (in every channel).
+struct ApproximationError {
+  double mean = 0.0;
+  double max = 0.0;
+  size_t normals = 0;
+};
+ApproximationError RelativeError(const std::vector<glm::dvec3>& truth, const std::vector<glm::dvec3>& approximation);
+
+}  // namespace daylit::relight
