@@ -237,6 +237,8 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"sunpos --frobnicate", "frobnicate"},
       {"relight-env " + std::string(DAYLIT_SOURCE_DIR) + "/recordings/courtyard-a --frame 99999",
        "--frame: 99999 is not in"},
+      {"estimate " + std::string(DAYLIT_SOURCE_DIR) + "/recordings/courtyard-a --samples -5",
+       "--samples: Value -5 not in range 100 to 1000000"},
   };
   for (const BadCall& call : calls) {
     const CliRun run = Daylit(call.args);  // NOLINT

@@ -62,7 +62,8 @@ void AddEstimateCommand(CLI::App& app) {
   cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
   cmd->add_option("--out", options->out, "Estimates CSV (default estimates.csv)");
   cmd->add_option("--plot", options->plot, "Plot PNG (default: the CSV's name with .png)");
-  cmd->add_option("--samples", options->estimate.sampler.samples, "Samples per frame (default 8000)");
+  cmd->add_option("--samples", options->estimate.sampler.samples, "Samples per frame (default 8000)")
+      ->check(CLI::Range(100, 1000000));
   cmd->callback([options] { RunEstimateCommand(*options); });
 }
 
