@@ -128,19 +128,6 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   // Medians (start, floor, spread) are taken over every `stride`-th sample: ~2000 of them give each
   // to well under 1% and cost a quarter of the time.
   const size_t stride = std::max<size_t>(1, n / 2000);
-  // Normal equations with weights w (all three regressors; unused ones are zero).
-  const auto normal_equations = [&](const std::vector<double>& weights, size_t m) {
-    NormalEquations eq;
-    for (size_t k = 0; k < m; ++k) {
-      const double wk = weights[k], x0 = x[0][k], x1 = x[1][k], x2 = x[2][k], yk = y[k];
-      eq.a[0][0] += wk * x0 * x0, eq.a[0][1] += wk * x0 * x1, eq.a[0][2] += wk * x0 * x2;
-      eq.a[1][1] += wk * x1 * x1, eq.a[1][2] += wk * x1 * x2, eq.a[2][2] += wk * x2 * x2;
-      eq.b[0] += wk * x0 * yk, eq.b[1] += wk * x1 * yk, eq.b[2] += wk * x2 * yk;
-      eq.yy += wk * yk * yk;
-    }
-    eq.a[1][0] = eq.a[0][1], eq.a[2][0] = eq.a[0][2], eq.a[2][1] = eq.a[1][2];
-    return eq;
-  };
   // One channel: E_sun and E_sky, or, with `split`, E_sun, E_clear and E_overcast; else the sky's
   // regressor is the clear one and the overcast one mixed by `share`. `start`, if given, replaces
   // the median-based start. Fits the samples `rows`.
@@ -157,6 +144,22 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
       x[2][k] = split ? a * s.overcast[c] : 0.0;
     }
     const std::array<bool, 3> free{with_sun, true, split};
+    // The weighted normal equations of the m samples with the weights in w (all three
+    // regressors; an unused one is zero), vectorised by Eigen.
+    const Eigen::Map<const Eigen::ArrayXd> ey(y.data(), static_cast<Eigen::Index>(m)),
+        ex0(x[0].data(), static_cast<Eigen::Index>(m)), ex1(x[1].data(), static_cast<Eigen::Index>(m)),
+        ex2(x[2].data(), static_cast<Eigen::Index>(m));
+    Eigen::Map<Eigen::ArrayXd> ew(w.data(), static_cast<Eigen::Index>(m));
+    const auto normal_equations = [&] {
+      NormalEquations eq;
+      const Eigen::ArrayXd w0 = ew * ex0, w1 = ew * ex1, w2 = ew * ex2;
+      eq.a[0][0] = (w0 * ex0).sum(), eq.a[0][1] = (w0 * ex1).sum(), eq.a[0][2] = (w0 * ex2).sum();
+      eq.a[1][1] = (w1 * ex1).sum(), eq.a[1][2] = (w1 * ex2).sum(), eq.a[2][2] = (w2 * ex2).sum();
+      eq.b[0] = (w0 * ey).sum(), eq.b[1] = (w1 * ey).sum(), eq.b[2] = (w2 * ey).sum();
+      eq.yy = (ew * ey.square()).sum();
+      eq.a[1][0] = eq.a[0][1], eq.a[2][0] = eq.a[0][2], eq.a[2][1] = eq.a[1][2];
+      return eq;
+    };
     ChannelFit fit{0.0, 0.0, 0.0};
     if (start != nullptr) {
       fit = *start;
@@ -169,8 +172,8 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
       }
       fit[1] = MedianInPlace(scratch, 0.0);
       if (scratch.empty()) {
-        std::fill(w.begin(), w.end(), 1.0);
-        fit = SolveNonNegative(normal_equations(w, m), {with_sun, true, false});
+        ew.setOnes();
+        fit = SolveNonNegative(normal_equations(), {with_sun, true, false});
       }
       scratch.clear();
       for (size_t k = 0; k < m; k += stride) {
@@ -180,31 +183,18 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
     }
     const auto predict = [&](size_t k) { return x[0][k] * fit[0] + x[1][k] * fit[1] + x[2][k] * fit[2]; };
     // IRLS, Cauchy weights on residuals relative to the prediction, floored at a tenth of the
-    // start's median prediction so that near-black points do not dominate; until the estimate
-    // moves less than 1e-5 (relative).
+    // start's median prediction so that near-black points do not dominate.
     scratch.clear();
     for (size_t k = 0; k < m; k += stride) scratch.push_back(predict(k));
     const double floor = std::max(1e-12, 0.1 * MedianInPlace(scratch, 0.0));
     const double inv_scale = 1.0 / options.cauchy_scale;
-    // The Cauchy weight of each sample's residual relative to the prediction (least squares on
-    // relative residuals: 1/scale² times the Cauchy weight 1/(1 + r²) = 1/(scale² + d²/c²) for
-    // a residual d), then the normal equations; vectorised by Eigen.
-    const Eigen::Map<const Eigen::ArrayXd> ey(y.data(), static_cast<Eigen::Index>(m)),
-        ex0(x[0].data(), static_cast<Eigen::Index>(m)), ex1(x[1].data(), static_cast<Eigen::Index>(m)),
-        ex2(x[2].data(), static_cast<Eigen::Index>(m));
-    Eigen::Map<Eigen::ArrayXd> ew(w.data(), static_cast<Eigen::Index>(m));
+    // Least squares on relative residuals: 1/scale² times the Cauchy weight 1/(1 + r²), that is
+    // 1/(scale² + d²/c²) for a residual d.
     const auto reweighted = [&] {
-      const Eigen::ArrayXd d = ey - (ex0 * fit[0] + ex1 * fit[1] + ex2 * fit[2]);
-      const Eigen::ArrayXd scale = (ex0 * fit[0] + ex1 * fit[1] + ex2 * fit[2]).max(floor);
-      ew = (scale.square() + d.square() * (inv_scale * inv_scale)).inverse();
-      NormalEquations eq;
-      const Eigen::ArrayXd w0 = ew * ex0, w1 = ew * ex1, w2 = ew * ex2;
-      eq.a[0][0] = (w0 * ex0).sum(), eq.a[0][1] = (w0 * ex1).sum(), eq.a[0][2] = (w0 * ex2).sum();
-      eq.a[1][1] = (w1 * ex1).sum(), eq.a[1][2] = (w1 * ex2).sum(), eq.a[2][2] = (w2 * ex2).sum();
-      eq.b[0] = (w0 * ey).sum(), eq.b[1] = (w1 * ey).sum(), eq.b[2] = (w2 * ey).sum();
-      eq.yy = (ew * ey.square()).sum();
-      eq.a[1][0] = eq.a[0][1], eq.a[2][0] = eq.a[0][2], eq.a[2][1] = eq.a[1][2];
-      return eq;
+      const Eigen::ArrayXd prediction = ex0 * fit[0] + ex1 * fit[1] + ex2 * fit[2];
+      const Eigen::ArrayXd d = ey - prediction;
+      ew = (prediction.max(floor).square() + d.square() * (inv_scale * inv_scale)).inverse();
+      return normal_equations();
     };
     // Until the estimate moves less than `tolerance` (relative). The split only feeds the pooled
     // overcast share, so it stops sooner.
@@ -217,12 +207,15 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
       fit = next;
       if (change < tolerance) break;
     }
-    for (size_t k = 0; k < m; ++k) relative[k] = (y[k] - predict(k)) / std::max(predict(k), floor);
+    for (size_t k = 0; k < m; ++k) {
+      const double prediction = predict(k);
+      relative[k] = (y[k] - prediction) / std::max(prediction, floor);
+    }
     return fit;
   };
   // The overcast share of the sky is one number for all channels (clouds are grey): fitted per
-  // channel (on half the samples), then pooled, then each channel fitted again with it. Per-channel shares let a small
-  // model error in one channel trade sun for sky there.
+  // channel (on half the samples), then pooled, then each channel fitted again with it.
+  // Per-channel shares let a small model error in one channel trade sun for sky there.
   double share = 0.0;
   std::array<ChannelFit, 3> split_fits{};
   if (two_skies) {
