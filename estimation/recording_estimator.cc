@@ -32,7 +32,6 @@ double Median(std::vector<double> v) { return MedianInPlace(v, static_cast<doubl
 
 // One frame as the estimator reads it: encoded RGB floats (video, PNG, JPEG) or linear ones (EXR).
 struct DecodedFrame {
-  size_t position = 0;  // in frames.csv
   bool ok = false;
   bool linear = false;
   cv::Mat rgb;
@@ -49,7 +48,10 @@ class FramePipeline {
     thread_ = std::thread([this] { Run(); });
   }
   ~FramePipeline() {
+    // Wakes a reader blocked on a full queue (abort), and empties the queue so that one that was
+    // still decoding pushes without waiting; either way it then sees stop_ and ends.
     stop_ = true;
+    queue_.abort();
     DecodedFrame dropped;
     while (queue_.try_pop(dropped)) {}
     thread_.join();
@@ -66,7 +68,6 @@ class FramePipeline {
     const std::vector<capture::FrameTime>& times = scene_.frame_times->frames;
     for (size_t i = 0; i < times.size() && !stop_; ++i) {
       DecodedFrame frame;
-      frame.position = i;
       try {
         frame.ok = Read(times[i].index, &frame);
       } catch (const InputError& e) {
@@ -76,7 +77,11 @@ class FramePipeline {
         frame.error = std::current_exception();
       }
       const bool failed = static_cast<bool>(frame.error);
-      while (!stop_ && !queue_.try_push(frame)) std::this_thread::yield();
+      try {
+        queue_.push(std::move(frame));  // waits while the estimation is 4 frames behind
+      } catch (const tbb::user_abort&) {
+        return;
+      }
       if (failed) return;
     }
   }
