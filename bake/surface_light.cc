@@ -110,4 +110,18 @@ void SunVisibility(const scene::RayCaster& caster, const glm::vec3* points, cons
   });
 }
 
+void DirectSun(const scene::RayCaster& caster, const glm::vec3* points, const glm::vec3* normals,
+               const std::vector<uint32_t>& indices, const glm::vec3& sun_dir, float offset_m, float* direct,
+               uint8_t* visible) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, indices.size(), 2048), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t k = range.begin(); k != range.end(); ++k) {
+      const uint32_t i = indices[k];
+      const float cos_sun = glm::dot(normals[i], sun_dir);
+      const bool lit = sun_dir.z > 0.0f && cos_sun > 0.0f && !caster.Occluded(points[i] + offset_m * normals[i], sun_dir);
+      direct[i] = lit ? cos_sun : 0.0f;
+      if (visible != nullptr) visible[i] = lit ? 1 : 0;
+    }
+  });
+}
+
 }  // namespace daylit::bake

@@ -65,4 +65,11 @@ void SkyVisibility(const scene::RayCaster& caster, const RayOptions& options, co
 void SunVisibility(const scene::RayCaster& caster, const glm::vec3* points, const glm::vec3* normals, size_t count,
                    const glm::vec3& sun_dir, float offset_m, uint8_t* visible);
 
+// The direct-sun term s·max(0, n·l) of the points `indices` of `points`/`normals` (for each
+// index i: direct[i], and visible[i] = s if `visible` is given; other entries untouched). 0 for
+// a sun at or below the horizon. This is what the online stages re-run when the sun has moved.
+void DirectSun(const scene::RayCaster& caster, const glm::vec3* points, const glm::vec3* normals,
+               const std::vector<uint32_t>& indices, const glm::vec3& sun_dir, float offset_m, float* direct,
+               uint8_t* visible = nullptr);
+
 }  // namespace daylit::bake

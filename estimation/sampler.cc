@@ -19,6 +19,7 @@ Sampler::Sampler(const bake::SceneBake& bake, const glm::vec3& capture_position,
   const bake::CameraGBuffer& gbuffer = bake.camera;
   for (size_t i = 0; i < gbuffer.diffuse.size(); ++i) {
     if (gbuffer.diffuse[i]) diffuse_pixels_.push_back(static_cast<uint32_t>(i));
+    if (gbuffer.surface[i] != bake::kNoSurface) model_pixels_.push_back(static_cast<uint32_t>(i));
   }
   // A fixed order: the same pixels are read frame after frame, so sampling adds no flicker.
   std::mt19937 rng(20060101u);
@@ -36,24 +37,12 @@ bool Sampler::SetSun(const glm::vec3& sun_dir) {
   const int w = gbuffer_.width, h = gbuffer_.height;
   // Sun visibility of every model pixel (not only diffuse ones), so that the shadow map in the
   // image is the model's own.
-  std::vector<uint32_t> model_pixels;
-  for (size_t i = 0; i < gbuffer_.surface.size(); ++i) {
-    if (gbuffer_.surface[i] != bake::kNoSurface) model_pixels.push_back(static_cast<uint32_t>(i));
-  }
-  const size_t n = model_pixels.size();
-  std::vector<glm::vec3> points(n), normals(n);
-  for (size_t k = 0; k < n; ++k) points[k] = gbuffer_.point[model_pixels[k]], normals[k] = gbuffer_.normal[model_pixels[k]];
-  std::vector<uint8_t> visible(n, 0);
-  if (sun_dir.z > 0.0f) bake::SunVisibility(caster_, points.data(), normals.data(), n, sun_dir, 2e-3f, visible.data());
-  std::fill(sunlit_.begin(), sunlit_.end(), 0);
-  std::fill(sun_term_.begin(), sun_term_.end(), 0.0f);
+  bake::DirectSun(caster_, gbuffer_.point.data(), gbuffer_.normal.data(), model_pixels_, sun_dir, 2e-3f,
+                  sun_term_.data(), sunlit_.data());
   cv::Mat lit(h, w, CV_8UC1, cv::Scalar(0));
   cv::Mat surface(h, w, CV_32SC1, cv::Scalar(-1));
-  for (size_t k = 0; k < n; ++k) {
-    const uint32_t i = model_pixels[k];
-    sunlit_[i] = visible[k];
-    sun_term_[i] = visible[k] ? glm::dot(normals[k], sun_dir) : 0.0f;
-    lit.at<uint8_t>(static_cast<int>(i) / w, static_cast<int>(i) % w) = visible[k] ? 255 : 0;
+  for (const uint32_t i : model_pixels_) {
+    lit.at<uint8_t>(static_cast<int>(i) / w, static_cast<int>(i) % w) = sunlit_[i] ? 255 : 0;
     surface.at<int32_t>(static_cast<int>(i) / w, static_cast<int>(i) % w) = static_cast<int32_t>(gbuffer_.surface[i]);
   }
   // Left out: pixels within the margin of a shadow edge (lit next to unlit) or of a silhouette

@@ -57,6 +57,7 @@ class Sampler {
   const scene::RayCaster& caster_;
   SamplerOptions options_;
   std::vector<uint32_t> diffuse_pixels_;  // in a fixed shuffled order
+  std::vector<uint32_t> model_pixels_;    // every pixel that sees the model
   std::optional<glm::vec3> sun_;
   std::vector<uint8_t> sunlit_, near_boundary_;
   std::vector<float> sun_term_;  // s·max(0, n·l) per pixel

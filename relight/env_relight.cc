@@ -41,7 +41,18 @@ EnvRelighter::EnvRelighter(const bake::SceneBake& bake, const glm::vec3& capture
       if (!chosen[rep]) chosen[rep] = 1, traced_.push_back(rep);
     }
   }
+  std::vector<uint32_t> slot(env.surface.size(), 0);
+  for (size_t k = 0; k < traced_.size(); ++k) slot[traced_[k]] = static_cast<uint32_t>(k);
+  for (uint32_t& rep : representative_) rep = slot[rep];
   terms_.resize(model_texels_.size());
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const uint32_t t = static_cast<uint32_t>(v) * static_cast<uint32_t>(w) + static_cast<uint32_t>(u);
+      if (!env.IsSky(t)) continue;
+      sky_texels_.push_back(t);
+      sky_dirs_.push_back(glm::vec3(scene::LatLongDirection(u, v, w, h)));
+    }
+  }
 }
 
 bool EnvRelighter::SetSun(const glm::vec3& sun_dir) {
@@ -49,23 +60,15 @@ bool EnvRelighter::SetSun(const glm::vec3& sun_dir) {
   sun_ = sun_dir;
   const bake::EnvMapMaps& env = bake_.env;
   // The direct sun at every model texel.
-  std::vector<glm::vec3> points(model_texels_.size()), normals(model_texels_.size());
-  for (size_t i = 0; i < model_texels_.size(); ++i) points[i] = env.point[model_texels_[i]], normals[i] = env.normal[model_texels_[i]];
-  std::vector<uint8_t> lit(model_texels_.size(), 0);
-  if (sun_dir.z > 0.0f) bake::SunVisibility(caster_, points.data(), normals.data(), points.size(), sun_dir, 2e-3f, lit.data());
   std::vector<float> direct(env.surface.size(), 0.0f);
-  for (size_t i = 0; i < model_texels_.size(); ++i) {
-    direct[model_texels_[i]] = lit[i] ? std::max(0.0f, glm::dot(normals[i], sun_dir)) : 0.0f;
-  }
+  bake::DirectSun(caster_, env.point.data(), env.normal.data(), model_texels_, sun_dir, 2e-3f, direct.data());
   // Transfer of the representatives, then every texel: its own direct terms, its
   // representative's reflected light (and, for the clear sky, its shape of what V lets through).
   std::vector<estimation::Transfer> total(traced_.size()), reflected(traced_.size());
   transfer_.Compute(traced_, sun_dir, direct.data(), total.data(), reflected.data());
-  std::vector<int32_t> index_of(env.surface.size(), -1);
-  for (size_t k = 0; k < traced_.size(); ++k) index_of[traced_[k]] = static_cast<int32_t>(k);
   for (size_t i = 0; i < model_texels_.size(); ++i) {
-    const uint32_t t = model_texels_[i], rep = representative_[i];
-    const size_t k = static_cast<size_t>(index_of[rep]);
+    const size_t k = representative_[i];
+    const uint32_t t = model_texels_[i], rep = traced_[k];
     const estimation::Transfer& r = reflected[k];
     if (rep == t) {
       terms_[i] = total[k];
@@ -78,19 +81,9 @@ bool EnvRelighter::SetSun(const glm::vec3& sun_dir) {
     terms_[i].clear = (v_rep > 0.01f ? clear_direct * (v / v_rep) : glm::vec3(v)) + r.clear;
   }
   // The sky's shape per sky texel.
-  std::vector<glm::vec3> dirs;
-  std::vector<uint32_t> sky_texels;
-  for (int v = 0; v < env.height; ++v) {
-    for (int u = 0; u < env.width; ++u) {
-      const uint32_t t = static_cast<uint32_t>(v) * static_cast<uint32_t>(env.width) + static_cast<uint32_t>(u);
-      if (!env.IsSky(t)) continue;
-      sky_texels.push_back(t);
-      dirs.push_back(glm::vec3(scene::LatLongDirection(u, v, env.width, env.height)));
-    }
-  }
-  const std::vector<glm::vec3> shape = transfer_.ClearSkyPerUnitDhi(sun_dir, dirs);
+  const std::vector<glm::vec3> shape = transfer_.ClearSkyPerUnitDhi(sun_dir, sky_dirs_);
   sky_shape_.assign(env.surface.size(), glm::vec3(0.0f));
-  for (size_t i = 0; i < sky_texels.size(); ++i) sky_shape_[sky_texels[i]] = shape[i];
+  for (size_t i = 0; i < sky_texels_.size(); ++i) sky_shape_[sky_texels_[i]] = shape[i];
   return true;
 }
 

@@ -51,8 +51,10 @@ class EnvRelighter {
   estimation::LightTransfer transfer_;
   std::optional<glm::vec3> sun_;
   std::vector<uint32_t> model_texels_;
-  std::vector<uint32_t> representative_;  // per model texel: the texel whose reflected light it takes
   std::vector<uint32_t> traced_;          // the representatives, each once
+  std::vector<uint32_t> representative_;  // per model texel: its representative, index into traced_
+  std::vector<uint32_t> sky_texels_;      // the texels that show sky, and their directions
+  std::vector<glm::vec3> sky_dirs_;
   // Per model texel (in model_texels_ order): the terms.
   std::vector<estimation::Transfer> terms_;
   // Per texel: the clear sky's radiance per unit DHI (sky texels only).
