@@ -171,7 +171,8 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
   return run;
 }
 
-FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, size_t position, const EstimateOptions& options) {
+FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster, size_t position,
+                  const EstimateOptions& options) {
   if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
   const std::vector<capture::FrameTime>& times = scene.frame_times->frames;
   if (position >= times.size()) {
@@ -193,7 +194,6 @@ FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, size_t
   out.row.sun_elevation_deg = sun.ApparentElevationDeg();
   out.row.sun_azimuth_deg = sun.azimuth_deg;
   out.sun_dir = glm::vec3(scene.GeoFrame().DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg));
-  const scene::RayCaster caster(scene.model);
   const glm::vec3 capture = scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f);
   Sampler sampler(bake, capture, caster, options.sampler);
   sampler.SetSun(out.sun_dir);

@@ -47,13 +47,14 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
 
 // The unfiltered fit of one frame (its position in frames.csv), as the estimator makes it:
 // decodes the recording up to it. Throws InputError if the position is out of range or the frame
-// cannot be decoded.
+// cannot be decoded. `caster`: the scene's model.
 struct FrameFit {
   FrameEstimate row;       // light and confidence: the fit's own
   SunSkyFitSummary fit;
   glm::vec3 sun_dir{0.0f};  // unit, scene coordinates
 };
-FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, size_t position, const EstimateOptions& options);
+FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster, size_t position,
+                  const EstimateOptions& options);
 
 // The stable CSV: frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,sky_g,
 // sky_b,confidence,samples.

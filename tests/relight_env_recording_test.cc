@@ -24,7 +24,7 @@ TEST(RelightEnvRecordingTest, RelitMapsMatchThePathTracedOnes) {
   const scene::RayCaster caster(scene.model);
   relight::EnvRelighter relighter(baked, glm::vec3(scene.envmap->position), caster);
   for (const int frame : {300, 347, 550, 598}) {
-    const estimation::FrameFit fit = estimation::FitFrame(scene, baked, static_cast<size_t>(frame), {});
+    const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, static_cast<size_t>(frame), {});
     relighter.SetSun(fit.sun_dir);
     std::vector<glm::vec3> radiance;
     relighter.Relight(fit.fit.light, fit.fit.overcast_share, &radiance);

@@ -29,7 +29,7 @@ TEST(VolumeRecordingTest, CourtyardVolumeMatchesBruteForceIrradiance) {
   const scene::Scene& scene = testing::Courtyard().scene;
   const bake::SceneBake& baked = testing::Courtyard().bake;
   const scene::RayCaster caster(scene.model);
-  const estimation::FrameFit fit = estimation::FitFrame(scene, baked, 550, {});
+  const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, 550, {});
   relight::EnvRelighter relighter(baked, glm::vec3(scene.envmap->position), caster);
   relighter.SetSun(fit.sun_dir);
   std::vector<glm::vec3> env;

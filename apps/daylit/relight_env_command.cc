@@ -37,12 +37,12 @@ void RunRelightEnv(const RelightEnvOptions& o) {
   if (position == times.size()) ThrowInputError("--frame: {} is not in {}", o.frame, scene.frame_times->file.string());
   bool loaded = false;
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, bake::CacheDir(scene, o.cache), &loaded);
-  const estimation::FrameFit fit = estimation::FitFrame(scene, baked, position, {});
+  const scene::RayCaster caster(scene.model);
+  const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, position, {});
   Log().info("frame {}: E_sun ({:.3g}, {:.3g}, {:.3g}), E_sky ({:.3g}, {:.3g}, {:.3g}), overcast share {:.2f}, "
              "confidence {:.2f}",
              o.frame, fit.fit.light.sun_rgb.x, fit.fit.light.sun_rgb.y, fit.fit.light.sun_rgb.z, fit.fit.light.sky_rgb.x,
              fit.fit.light.sky_rgb.y, fit.fit.light.sky_rgb.z, fit.fit.overcast_share, fit.fit.confidence);
-  const scene::RayCaster caster(scene.model);
   relight::EnvRelighter relighter(baked, glm::vec3(scene.envmap->position), caster);
   relighter.SetSun(fit.sun_dir);
   std::vector<glm::vec3> radiance;
