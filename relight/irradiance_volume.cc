@@ -100,16 +100,19 @@ void IrradianceVolume::Update(const std::vector<glm::vec3>& env_radiance) {
   }
 }
 
+glm::vec3 IrradianceVolume::Evaluate(size_t probe, const Sh9Basis& y) const {
+  glm::vec3 e(0.0f);
+  for (int c = 0; c < kCoefficients; ++c) {
+    const float* v = &coefficients_[(probe * kCoefficients + static_cast<size_t>(c)) * 3];
+    e += static_cast<float>(y[static_cast<size_t>(c)]) * glm::vec3(v[0], v[1], v[2]);
+  }
+  return e;
+}
+
 glm::vec3 IrradianceVolume::ProbeIrradiance(int i, int j, int k, const glm::vec3& normal) const {
   const glm::ivec3 n = gather_.resolution;
   const size_t p = (static_cast<size_t>(k) * n.y + j) * n.x + i;
-  const Sh9Basis y = EvalSh9(glm::dvec3(normal));
-  glm::vec3 e(0.0f);
-  for (int c = 0; c < kCoefficients; ++c) {
-    const float* v = &coefficients_[(p * kCoefficients + static_cast<size_t>(c)) * 3];
-    e += static_cast<float>(y[static_cast<size_t>(c)]) * glm::vec3(v[0], v[1], v[2]);
-  }
-  return glm::max(e, glm::vec3(0.0f));
+  return glm::max(Evaluate(p, EvalSh9(glm::dvec3(normal))), glm::vec3(0.0f));
 }
 
 glm::vec3 IrradianceVolume::Irradiance(const glm::vec3& point, const glm::vec3& normal) const {
@@ -131,11 +134,7 @@ glm::vec3 IrradianceVolume::Irradiance(const glm::vec3& point, const glm::vec3& 
     float w = 1.0f;
     for (int a = 0; a < 3; ++a) w *= o[a] ? f[a] : 1.0f - f[a];
     if (w == 0.0f) continue;
-    const size_t p = (static_cast<size_t>(q.z) * n.y + q.y) * n.x + q.x;
-    for (int c = 0; c < kCoefficients; ++c) {
-      const float* v = &coefficients_[(p * kCoefficients + static_cast<size_t>(c)) * 3];
-      e += w * static_cast<float>(y[static_cast<size_t>(c)]) * glm::vec3(v[0], v[1], v[2]);
-    }
+    e += w * Evaluate((static_cast<size_t>(q.z) * n.y + q.y) * n.x + q.x, y);
   }
   return glm::max(e, glm::vec3(0.0f));
 }

@@ -21,6 +21,7 @@
 #include <glm/glm.hpp>
 
 #include "bake/bake.h"
+#include "relight/sh9.h"
 #include "scene/raycaster.h"
 
 namespace daylit::relight {
@@ -45,6 +46,8 @@ class IrradianceVolume {
   size_t InsideCount() const;
 
  private:
+  glm::vec3 Evaluate(size_t probe, const Sh9Basis& y) const;  // Σ_c coefficient_c · y_c
+
   const bake::GatherTables& gather_;
   std::vector<uint8_t> inside_;
   std::vector<float> basis_;         // [c · N + d]: Â_l · Y_c(direction d) · 4π/N
