@@ -43,7 +43,9 @@ glm::dvec3 LightSet::Irradiance(const glm::vec3& normal) const {
   return e;
 }
 
-LightSet MedianCut(const scene::HdrImage& map, int levels) {
+LightSet MedianCut(const scene::HdrImage& map, int levels) { return MedianCutLights(map, 1 << levels); }
+
+LightSet MedianCutLights(const scene::HdrImage& map, int n) {
   const int w = map.width, h = map.height;
   std::vector<double> luminance(static_cast<size_t>(w) * h);
   for (int v = 0; v < h; ++v) {
@@ -54,36 +56,52 @@ LightSet MedianCut(const scene::HdrImage& map, int levels) {
     }
   }
   const SummedArea sat(w, h, luminance);
-  std::vector<Region> regions = {{0, 0, w, h}};
-  for (int level = 0; level < levels; ++level) {
-    std::vector<Region> next;
-    for (const Region& r : regions) {
-      // The longer side, the width measured at the region's middle latitude (sin θ).
-      const double theta = glm::pi<double>() * 0.5 * (r.v0 + r.v1) / h;
-      const double width = (r.u1 - r.u0) * std::sin(theta) * 2.0 * glm::pi<double>() / w;
-      const double height = (r.v1 - r.v0) * glm::pi<double>() / h;
-      const bool split_u = width >= height ? r.u1 - r.u0 > 1 : r.v1 - r.v0 <= 1;
-      const int lo = split_u ? r.u0 : r.v0, hi = split_u ? r.u1 : r.v1;
-      if (hi - lo < 2) {  // a single texel: it cannot be cut; it stays one light (an empty twin)
-        next.push_back(r);
-        continue;
-      }
-      const double total = sat.Sum(r.u0, r.v0, r.u1, r.v1);
-      // The cut c in (lo, hi) where the first part's sum is closest to half.
-      int cut = lo + 1;
-      double best = 1e300;
-      for (int c = lo + 1; c < hi; ++c) {
-        const double part = split_u ? sat.Sum(r.u0, r.v0, c, r.v1) : sat.Sum(r.u0, r.v0, r.u1, c);
-        const double d = std::abs(part - 0.5 * total);
-        if (d < best) best = d, cut = c;
-      }
-      next.push_back(split_u ? Region{r.u0, r.v0, cut, r.v1} : Region{r.u0, r.v0, r.u1, cut});
-      next.push_back(split_u ? Region{cut, r.v0, r.u1, r.v1} : Region{r.u0, cut, r.u1, r.v1});
+  // Cuts `r` in two (appended to `out`) along its longer side, the width measured at its middle
+  // latitude (sin θ), where the luminance halves; a single texel stays whole.
+  const auto split = [&](const Region& r, std::vector<Region>& out) {
+    const double theta = glm::pi<double>() * 0.5 * (r.v0 + r.v1) / h;
+    const double width = (r.u1 - r.u0) * std::sin(theta) * 2.0 * glm::pi<double>() / w;
+    const double height = (r.v1 - r.v0) * glm::pi<double>() / h;
+    const bool split_u = width >= height ? r.u1 - r.u0 > 1 : r.v1 - r.v0 <= 1;
+    const int lo = split_u ? r.u0 : r.v0, hi = split_u ? r.u1 : r.v1;
+    if (hi - lo < 2) {
+      out.push_back(r);
+      return;
     }
+    const double total = sat.Sum(r.u0, r.v0, r.u1, r.v1);
+    // The cut c in (lo, hi) where the first part's sum is closest to half.
+    int cut = lo + 1;
+    double best = 1e300;
+    for (int c = lo + 1; c < hi; ++c) {
+      const double part = split_u ? sat.Sum(r.u0, r.v0, c, r.v1) : sat.Sum(r.u0, r.v0, r.u1, c);
+      const double d = std::abs(part - 0.5 * total);
+      if (d < best) best = d, cut = c;
+    }
+    out.push_back(split_u ? Region{r.u0, r.v0, cut, r.v1} : Region{r.u0, r.v0, r.u1, cut});
+    out.push_back(split_u ? Region{cut, r.v0, r.u1, r.v1} : Region{r.u0, cut, r.u1, r.v1});
+  };
+  std::vector<Region> regions = {{0, 0, w, h}};
+  // Whole levels of Debevec's cut while they fit in n, then the brightest regions cut once more.
+  while (2 * regions.size() <= static_cast<size_t>(n)) {
+    std::vector<Region> next;
+    for (const Region& r : regions) split(r, next);
+    if (next.size() == regions.size()) break;  // nothing left to cut
     regions.swap(next);
   }
+  const size_t extra = static_cast<size_t>(n) - std::min(regions.size(), static_cast<size_t>(n));
+  std::stable_sort(regions.begin(), regions.end(), [&](const Region& a, const Region& b) {
+    return sat.Sum(a.u0, a.v0, a.u1, a.v1) > sat.Sum(b.u0, b.v0, b.u1, b.v1);
+  });
+  std::vector<Region> cut;
+  for (size_t i = 0; i < regions.size(); ++i) {
+    if (i < extra) {
+      split(regions[i], cut);
+    } else {
+      cut.push_back(regions[i]);
+    }
+  }
   LightSet set;
-  for (const Region& r : regions) {
+  for (const Region& r : cut) {
     glm::dvec3 power(0.0), centroid(0.0);
     for (int v = r.v0; v < r.v1; ++v) {
       const double solid_angle = scene::LatLongTexelSolidAngle(v, w, h);
@@ -112,6 +130,21 @@ ApproximationError RelativeError(const std::vector<glm::dvec3>& truth, const std
     error.mean += e, error.max = std::max(error.max, e);
     ++error.normals;
   }
+  if (error.normals > 0) error.mean /= static_cast<double>(error.normals);
+  return error;
+}
+
+ApproximationError RelativeToMaxError(const std::vector<glm::dvec3>& truth, const std::vector<glm::dvec3>& approximation) {
+  glm::dvec3 peak(0.0);
+  for (const glm::dvec3& e : truth) peak = glm::max(peak, e);
+  ApproximationError error;
+  if (!glm::all(glm::greaterThan(peak, glm::dvec3(0.0)))) return error;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const glm::dvec3 r = glm::abs(approximation[i] - truth[i]) / peak;
+    const double e = (r.x + r.y + r.z) / 3.0;
+    error.mean += e, error.max = std::max(error.max, e);
+  }
+  error.normals = truth.size();
   if (error.normals > 0) error.mean /= static_cast<double>(error.normals);
   return error;
 }

@@ -34,6 +34,10 @@ struct LightSet {
 // luminance-weighted centroid direction carrying the region's whole power Σ L·ΔΩ (RGB). No ambient.
 LightSet MedianCut(const scene::HdrImage& map, int levels);
 
+// Median cut for any number of lights n ≥ 1: whole levels while 2^levels ≤ n, then the
+// n − 2^levels regions of most power cut once more. For n = 2^levels it is MedianCut.
+LightSet MedianCutLights(const scene::HdrImage& map, int n);
+
 // Seed 002's measure over a set of normals: the per-normal relative error |E − E_true| / E_true,
 // averaged over RGB; its mean and max over the normals whose true irradiance is at least 1e-3 of
 // the maximum (in every channel).
@@ -43,5 +47,9 @@ struct ApproximationError {
   size_t normals = 0;
 };
 ApproximationError RelativeError(const std::vector<glm::dvec3>& truth, const std::vector<glm::dvec3>& approximation);
+
+// Ramamoorthi & Hanrahan's measure: |E − E_true| over the maximum true irradiance (per channel),
+// averaged over RGB; mean and max over all normals.
+ApproximationError RelativeToMaxError(const std::vector<glm::dvec3>& truth, const std::vector<glm::dvec3>& approximation);
 
 }  // namespace daylit::relight

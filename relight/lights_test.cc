@@ -39,6 +39,20 @@ TEST(MedianCutTest, LightsCarryTheMapsPowerAndSplitItEvenly) {
   for (const DirectionalLight& l : set.lights) EXPECT_NEAR(luminance(l.irradiance), share, 0.2 * share);
 }
 
+TEST(MedianCutTest, AnyNumberOfLightsKeepsThePowerAndExtendsTheLevels) {
+  const scene::HdrImage map = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/stpeters_latlong_1024x512.hdr");
+  const LightSet eight = MedianCut(map, 3), five = MedianCutLights(map, 5), also_eight = MedianCutLights(map, 8);
+  ASSERT_EQ(five.lights.size(), 5u);
+  ASSERT_EQ(also_eight.lights.size(), 8u);
+  glm::dvec3 power5(0.0), power8(0.0);
+  for (const DirectionalLight& l : five.lights) power5 += glm::dvec3(l.irradiance);
+  for (size_t i = 0; i < 8; ++i) {
+    power8 += glm::dvec3(eight.lights[i].irradiance);
+    EXPECT_EQ(eight.lights[i].direction, also_eight.lights[i].direction);  // MedianCut is the 2^k case
+  }
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(power5[c], power8[c], 1e-6 * power8[c]);
+}
+
 TEST(MedianCutTest, ReproducesSeed002sErrorsOnGalileo) {
   // Seed 002, Fig. 2 caption: median cut with 8 lights on Galileo's tomb, about 25% mean and over
   // 75% max per-normal relative error; more lights, less error.
