@@ -115,6 +115,10 @@ void CheckEnvMap(const HdrImage& image, const std::string& name) {
   if (image.width != 2 * image.height) {
     ThrowInputError("{}: {}x{} is not a 2:1 latitude-longitude map", name, image.width, image.height);
   }
+  CheckRadianceValues(image, name);
+}
+
+void CheckRadianceValues(const HdrImage& image, const std::string& name) {
   size_t non_finite = 0, negative = 0, first = SIZE_MAX;
   for (size_t i = 0; i < image.rgb.size(); ++i) {
     const float v = image.rgb[i];

@@ -28,6 +28,9 @@ HdrImage ReadHdrImage(const std::filesystem::path& path);
 // (u 40, v 3)").
 void CheckEnvMap(const HdrImage& image, const std::string& name);
 
+// The value half of CheckEnvMap, for images of any shape.
+void CheckRadianceValues(const HdrImage& image, const std::string& name);
+
 enum class ExrPixelType { kHalf, kFloat, kUint };
 
 // One planar channel to write: `data` points to width·height values of the given type
