@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <glm/gtc/constants.hpp>
+#include <nlohmann/json.hpp>
 
 #include "scene/latlong.h"
 
@@ -41,6 +42,14 @@ glm::dvec3 LightSet::Irradiance(const glm::vec3& normal) const {
   glm::dvec3 e(ambient);
   for (const DirectionalLight& l : lights) e += glm::dvec3(l.irradiance) * std::max(0.0, static_cast<double>(glm::dot(normal, l.direction)));
   return e;
+}
+
+std::string LightSetJson(const LightSet& set) {
+  const auto array = [](const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
+  nlohmann::json lights = nlohmann::json::array();
+  for (const DirectionalLight& l : set.lights) lights.push_back({{"direction", array(l.direction)}, {"irradiance", array(l.irradiance)}});
+  const nlohmann::json json = {{"ambient", array(set.ambient)}, {"lights", lights}};
+  return json.dump(2) + "\n";
 }
 
 LightSet MedianCut(const scene::HdrImage& map, int levels) { return MedianCutLights(map, 1 << levels); }

@@ -8,6 +8,7 @@
 // (docs/design.md's lat-long convention).
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -27,6 +28,10 @@ struct LightSet {
 
   glm::dvec3 Irradiance(const glm::vec3& normal) const;
 };
+
+// `daylit lights`' file format: {"ambient": [r, g, b], "lights": [{"direction": [x, y, z],
+// "irradiance": [r, g, b]}, ...]}, with the meanings above.
+std::string LightSetJson(const LightSet& set);
 
 // Debevec's Median Cut (seed 002 §4.1): the map, weighted by texel solid angle, is split
 // `levels` times, each region along its longer side (width measured at its middle latitude) where

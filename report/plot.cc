@@ -33,6 +33,21 @@ void DrawDashed(cv::Mat& image, cv::Point a, cv::Point b, const cv::Scalar& colo
   }
 }
 
+// Tick positions on a log10 axis covering [lo, hi] (in log10 units): the decades, and 2 and 5
+// times them when the range spans few decades.
+std::vector<double> LogTicks(double lo, double hi) {
+  std::vector<double> ticks;
+  const bool fine = hi - lo < 3.0;
+  for (int k = static_cast<int>(std::floor(lo)); k <= static_cast<int>(std::ceil(hi)); ++k) {
+    for (const double m : {1.0, 2.0, 5.0}) {
+      if (m != 1.0 && !fine) continue;
+      const double t = k + std::log10(m);
+      if (t >= lo - 1e-9 && t <= hi + 1e-9) ticks.push_back(t);
+    }
+  }
+  return ticks;
+}
+
 }  // namespace
 
 std::array<int, 3> SeriesColor(int index) {
@@ -62,8 +77,15 @@ std::vector<double> NiceTicks(double lo, double hi, int target) {
 
 cv::Mat LinePlot::Render() const {
   cv::Mat image(options_.height, options_.width, CV_8UC3, cv::Scalar(255, 255, 255));
+  // Log axes plot log10 of the values; a value ≤ 0 has none and becomes a gap.
+  const auto log_of = [](double v) { return v > 0.0 ? std::log10(v) : NAN; };
+  std::vector<Series> plotted = series_;
+  for (Series& s : plotted) {
+    if (options_.x_log) std::transform(s.x.begin(), s.x.end(), s.x.begin(), log_of);
+    if (options_.y_log) std::transform(s.y.begin(), s.y.end(), s.y.begin(), log_of);
+  }
   double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
-  for (const Series& s : series_) {
+  for (const Series& s : plotted) {
     for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
       x0 = std::min(x0, s.x[i]), x1 = std::max(x1, s.x[i]);
@@ -72,7 +94,7 @@ cv::Mat LinePlot::Render() const {
   }
   const bool has_data = x0 <= x1;
   if (!has_data) x0 = 0, x1 = 1, y0 = 0, y1 = 1;
-  if (options_.y_from_zero) y0 = std::min(y0, 0.0), y1 = std::max(y1, 0.0);
+  if (options_.y_from_zero && !options_.y_log) y0 = std::min(y0, 0.0), y1 = std::max(y1, 0.0);
   if (x1 == x0) x0 -= 0.5, x1 += 0.5;
   if (y1 == y0) y0 -= 0.5, y1 += 0.5;
   const double pad = 0.05 * (y1 - y0);
@@ -83,12 +105,15 @@ cv::Mat LinePlot::Render() const {
     return cv::Point(area.x + static_cast<int>(std::lround((x - x0) / (x1 - x0) * area.width)),
                      area.y + area.height - static_cast<int>(std::lround((y - y0) / (y1 - y0) * area.height)));
   };
-  const std::vector<double> xt = NiceTicks(x0, x1, 10), yt = NiceTicks(y0, y1, 6);
+  const std::vector<double> xt = options_.x_log ? LogTicks(x0, x1) : NiceTicks(x0, x1, 10);
+  const std::vector<double> yt = options_.y_log ? LogTicks(y0, y1) : NiceTicks(y0, y1, 6);
   const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 1.0, ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
+  const auto x_label = [&](double t) { return options_.x_log ? fmt::format("{:g}", std::pow(10.0, t)) : TickLabel(t, xstep); };
+  const auto y_label = [&](double t) { return options_.y_log ? fmt::format("{:g}", std::pow(10.0, t)) : TickLabel(t, ystep); };
   for (const double t : yt) {
     const cv::Point p = to_px(x0, t);
     cv::line(image, p, {area.x + area.width, p.y}, kGrid, 1);
-    const std::string label = TickLabel(t, ystep);
+    const std::string label = y_label(t);
     int base = 0;
     const cv::Size size = cv::getTextSize(label, kFont, 0.45, 1, &base);
     cv::putText(image, label, {area.x - size.width - 6, p.y + size.height / 2}, kFont, 0.45, kInk, 1, cv::LINE_AA);
@@ -96,13 +121,13 @@ cv::Mat LinePlot::Render() const {
   for (const double t : xt) {
     const cv::Point p = to_px(t, y0);
     cv::line(image, {p.x, area.y}, p, kGrid, 1);
-    const std::string label = TickLabel(t, xstep);
+    const std::string label = x_label(t);
     int base = 0;
     const cv::Size size = cv::getTextSize(label, kFont, 0.45, 1, &base);
     cv::putText(image, label, {p.x - size.width / 2, area.y + area.height + 18}, kFont, 0.45, kInk, 1, cv::LINE_AA);
   }
   cv::rectangle(image, area, kInk, 1);
-  for (const Series& s : series_) {
+  for (const Series& s : plotted) {
     const cv::Scalar color = Bgr(s.rgb);
     if (s.markers_only) {
       for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
@@ -123,12 +148,12 @@ cv::Mat LinePlot::Render() const {
   cv::putText(image, options_.x_label, {area.x + area.width / 2 - 40, options_.height - 8}, kFont, 0.5, kInk, 1, cv::LINE_AA);
   cv::putText(image, options_.y_label, {6, kTop - 10}, kFont, 0.45, kInk, 1, cv::LINE_AA);
   int legend_width = 0;
-  for (const Series& s : series_) {
+  for (const Series& s : plotted) {
     int base = 0;
     legend_width = std::max(legend_width, cv::getTextSize(s.name, kFont, 0.45, 1, &base).width);
   }
   int legend_y = area.y + 18;
-  for (const Series& s : series_) {
+  for (const Series& s : plotted) {
     const int x = area.x + area.width - legend_width - 44;
     if (s.markers_only) {
       cv::circle(image, {x + 12, legend_y - 5}, 3, Bgr(s.rgb), cv::FILLED, cv::LINE_AA);

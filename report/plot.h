@@ -26,6 +26,8 @@ struct PlotOptions {
   int width = 1200;   // pixels
   int height = 420;   // pixels
   bool y_from_zero = false;  // include 0 in the y range
+  bool x_log = false;        // logarithmic axes (values ≤ 0 are left out), ticks at 1, 2, 5 × 10^k
+  bool y_log = false;
 };
 
 class LinePlot {

@@ -33,6 +33,25 @@ TEST(PlotTest, SeriesAreDrawnWhereTheirValuesAre) {
   EXPECT_EQ(red_in({85, 40, 100, 80}), 0);
 }
 
+TEST(PlotTest, LogAxisPutsEachDecadeTheSameDistanceApart) {
+  PlotOptions options{"t", "x", "y", 400, 300};
+  options.y_log = true;
+  LinePlot plot(options);
+  Series decades{"decades", {0, 1, 2}, {1, 10, 100}, {255, 0, 0}};
+  decades.markers_only = true;
+  plot.Add(decades);
+  const cv::Mat image = plot.Render();
+  const auto red_in = [&](cv::Rect r) {
+    cv::Mat mask;
+    cv::inRange(image(r), cv::Scalar(0, 0, 200), cv::Scalar(80, 80, 255), mask);
+    return cv::countNonZero(mask);
+  };
+  // The plot area spans rows 50-252 and columns 80-380; 10 is half way up on a log axis (at
+  // 10% of the height on a linear one).
+  EXPECT_GT(red_in({224, 145, 12, 12}), 5);
+  EXPECT_EQ(red_in({224, 225, 12, 12}), 0);
+}
+
 TEST(PlotTest, WritesAReadablePng) {
   const auto path = std::filesystem::temp_directory_path() / ("daylit_plot_" + std::to_string(::getpid()) + ".png");
   LinePlot a({"a", "", "", 300, 200, false}), b({"b", "", "", 300, 100, false});

@@ -8,13 +8,17 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "bake/synthetic_recording.h"
 #include "capture/response.h"
 #include "base/atomic_file.h"
 #include "base/csv.h"
+#include "relight/exact_irradiance.h"
+#include "relight/lights.h"
 #include "scene/hdr_image.h"
 #include "scene/scene_test_util.h"
 
@@ -48,9 +52,10 @@ CliRun Daylit(const std::string& args) {
 }
 
 const std::string kRecording = DAYLIT_SOURCE_DIR "/recordings/courtyard-a";
+const std::string kProbe = DAYLIT_SOURCE_DIR "/probes/stpeters_latlong_1024x512.hdr";
 
 TEST(CliTest, HelpForEverySubcommand) {
-  for (const char* sub : {"", "sunpos ", "info "}) {
+  for (const char* sub : {"", "sunpos ", "info ", "lights "}) {
     const CliRun run = Daylit(std::string(sub) + "--help");
     EXPECT_EQ(run.exit_code, 0) << sub;
     EXPECT_NE(run.out.find("Usage"), std::string::npos) << sub << run.out;
@@ -219,6 +224,49 @@ struct BadCall {
   std::string error;  // expected on stderr
 };
 
+TEST(CliTest, LightsWritesTheLightsTheirErrorsAndTheAutomaticN) {
+  const fs::path out = fs::temp_directory_path() / ("daylit_cli_lights_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const CliRun run = Daylit("lights " + kProbe + " --n 1,2,4,8 --threshold 0.05 --out " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("SH9 relative to the maximum irradiance"), std::string::npos) << run.out;
+  const CsvTable errors = ReadCsvFile(out / "errors.csv");
+  ASSERT_EQ(errors.header, (std::vector<std::string>{"method", "n", "mean_error", "max_error"}));
+  // The file's lights, evaluated as its format says (E(n) = ambient + Σ irradiance·max(0, n·d)),
+  // give the error the CSV reports against the exact irradiance.
+  const scene::HdrImage map = scene::ReadHdrImage(kProbe);
+  const std::vector<glm::vec3> normals = relight::IcosahedronNormals(5);
+  const std::vector<glm::dvec3> truth = relight::ExactIrradiance(map, normals);
+  std::map<std::string, double> mean_of;
+  for (const auto& row : errors.rows) mean_of[row[0] + "_" + row[1]] = std::stod(row[2]);
+  for (const char* name : {"mediancut_1", "mediancut_8", "io_1", "io_4"}) {
+    ASSERT_TRUE(mean_of.count(name)) << name;
+    const nlohmann::json json = nlohmann::json::parse(ReadTextFile(out / (std::string("lights_") + name + ".json")));
+    relight::LightSet set;
+    set.ambient = glm::vec3(json["ambient"][0], json["ambient"][1], json["ambient"][2]);
+    for (const auto& l : json["lights"]) {
+      set.lights.push_back({glm::vec3(l["direction"][0], l["direction"][1], l["direction"][2]),
+                            glm::vec3(l["irradiance"][0], l["irradiance"][1], l["irradiance"][2])});
+    }
+    std::vector<glm::dvec3> e(normals.size());
+    for (size_t i = 0; i < normals.size(); ++i) e[i] = set.Irradiance(normals[i]);
+    EXPECT_NEAR(relight::RelativeError(truth, e).mean, mean_of[name], 1e-5) << name;
+  }
+  EXPECT_TRUE(mean_of.count("sh_9"));
+  EXPECT_LT(mean_of["io_4"], 0.05);
+  EXPECT_GT(mean_of["mediancut_8"], 0.05);
+  // The automatic N: the smallest with a mean error below 5%; median cut's search adds its rows.
+  const nlohmann::json automatic = nlohmann::json::parse(ReadTextFile(out / "automatic.json"));
+  const int io_n = automatic["io"]["n"], mc_n = automatic["mediancut"]["n"];
+  EXPECT_LT(mean_of["io_" + std::to_string(io_n)], 0.05);
+  EXPECT_GE(mean_of["io_" + std::to_string(io_n - 1)], 0.05);
+  EXPECT_LT(mean_of["mediancut_" + std::to_string(mc_n)], 0.05);
+  EXPECT_GE(mean_of["mediancut_" + std::to_string(mc_n - 1)], 0.05);
+  EXPECT_TRUE(fs::is_regular_file(out / "errors.png"));
+  EXPECT_TRUE(fs::is_regular_file(out / "sh9.json"));
+  fs::remove_all(out);
+}
+
 TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
   scene::testing::SceneSandbox sandbox("cli");
   sandbox.WriteText("broken.json", "{\"format\": \"daylit-recording/1\",");
@@ -239,6 +287,14 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
        "--frame: 99999 is not in"},
       {"estimate " + std::string(DAYLIT_SOURCE_DIR) + "/recordings/courtyard-a --samples -5",
        "--samples: Value -5 not in range 100 to 1000000"},
+      {"lights " + kProbe + " --n 0 --out " + dir + "/l", "--n: 0 lights; the number of lights must be in [1, 128]"},
+      {"lights " + kProbe + " --n 1,500 --out " + dir + "/l", "--n: 500 lights; the number of lights must be in [1, 128]"},
+      {"lights " + kProbe + " --n 2000 --method mediancut --out " + dir + "/l",
+       "--n: 2000 lights; the number of lights must be in [1, 1024]"},
+      {"lights " + kProbe + " --n four --out " + dir + "/l", "--n: 'four' is not a number of lights"},
+      {"lights " + kProbe + " --method kmeans --out " + dir + "/l", "--method: 'kmeans' is not one of mediancut, io, sh"},
+      {"lights " + kProbe + " --threshold 5 --out " + dir + "/l", "--threshold: 5 is not a mean relative error in (0, 1)"},
+      {"lights " + dir + "/broken.json --out " + dir + "/l", "broken.json"},
   };
   for (const BadCall& call : calls) {
     const CliRun run = Daylit(call.args);  // NOLINT

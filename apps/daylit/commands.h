@@ -11,5 +11,6 @@ void AddInfoCommand(CLI::App& app);
 void AddBakeCommand(CLI::App& app);
 void AddEstimateCommand(CLI::App& app);
 void AddRelightEnvCommand(CLI::App& app);
+void AddLightsCommand(CLI::App& app);
 
 }  // namespace daylit::app

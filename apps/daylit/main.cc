@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   daylit::app::AddBakeCommand(app);
   daylit::app::AddEstimateCommand(app);
   daylit::app::AddRelightEnvCommand(app);
+  daylit::app::AddLightsCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
