@@ -11,6 +11,8 @@
 #include "relight/env_relight.h"
 #include "relight/exact_irradiance.h"
 #include "relight/irradiance_volume.h"
+#include "relight/light_fit.h"
+#include "relight/lights.h"
 #include "scene/scene.h"
 #include "scene/latlong.h"
 
@@ -66,6 +68,30 @@ void BM_ExactIrradianceMap1024x512(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(ExactIrradianceMap(probe, 1024, 512).data());
 }
 BENCHMARK(BM_ExactIrradianceMap1024x512)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+
+// Irradiance Optimization of N lights from a 1024×512 probe, all of it: the exact irradiance at
+// the fitting normals, median cut's start and the Ceres fit (bar for 8 lights ≤ 200 ms on 2
+// cores). Rooitou Park (outdoor, with the sun) takes the most iterations of the bundled probes.
+void BM_IrradianceOptimization(benchmark::State& state, const char* file) {
+  const scene::HdrImage probe = scene::ReadHdrImage(std::string(DAYLIT_SOURCE_DIR "/probes/") + file);
+  int iterations = 0;
+  for (auto _ : state) {
+    const LightFitResult fit = IrradianceOptimization(probe, static_cast<int>(state.range(0)));
+    iterations = fit.iterations;
+    benchmark::DoNotOptimize(fit.lights.lights.data());
+  }
+  state.counters["lm_iterations"] = iterations;
+}
+BENCHMARK_CAPTURE(BM_IrradianceOptimization, galileo, "galileo_latlong_1024x512.hdr")
+    ->Arg(4)->Arg(8)->Arg(32)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_IrradianceOptimization, rooitou, "rooitou_park_1k.hdr")
+    ->Arg(4)->Arg(8)->Arg(32)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_MedianCut(benchmark::State& state) {
+  const scene::HdrImage probe = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
+  for (auto _ : state) benchmark::DoNotOptimize(MedianCutLights(probe, static_cast<int>(state.range(0))).lights.data());
+}
+BENCHMARK(BM_MedianCut)->Arg(8)->Arg(128)->Unit(benchmark::kMillisecond);
 
 struct Courtyard {
   scene::Scene scene = scene::LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a");

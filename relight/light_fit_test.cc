@@ -10,11 +10,6 @@
 namespace daylit::relight {
 namespace {
 
-std::vector<glm::dvec3> IrradianceOf(const LightSet& set, const std::vector<glm::vec3>& normals) {
-  std::vector<glm::dvec3> e(normals.size());
-  for (size_t i = 0; i < normals.size(); ++i) e[i] = set.Irradiance(normals[i]);
-  return e;
-}
 
 double AngleDegrees(const glm::vec3& a, const glm::vec3& b) {
   return glm::degrees(std::acos(std::clamp(static_cast<double>(glm::dot(glm::normalize(a), glm::normalize(b))), -1.0, 1.0)));
@@ -71,7 +66,7 @@ TEST(LightFitTest, AnalyticJacobianMatchesCentralDifferences) {
 TEST(LightFitTest, RecoversKnownLightsFromAPerturbedStart) {
   const LightSet truth_set = ThreeLights();
   const std::vector<glm::vec3> normals = FitNormals(3);
-  const std::vector<glm::dvec3> truth = IrradianceOf(truth_set, normals);
+  const std::vector<glm::dvec3> truth = truth_set.Irradiance(normals);
   LightSet start = truth_set;
   start.ambient = glm::vec3(0.0f);
   const glm::mat3 turn = glm::mat3(glm::vec3(0.985f, 0.17f, 0.0f), glm::vec3(-0.17f, 0.985f, 0.0f), glm::vec3(0, 0, 1));
@@ -107,10 +102,10 @@ TEST(LightFitTest, IrradianceOptimizationNeedsFarFewerLightsThanMedianCutOnRealP
     for (int n = 1; n <= io_bar && reached.io == 0; ++n) {
       const LightFitResult fit = IrradianceOptimization(map, n);
       EXPECT_TRUE(fit.converged) << file << ", " << n << " lights: " << fit.termination;
-      if (RelativeError(truth, IrradianceOf(fit.lights, normals)).mean < 0.05) reached.io = n;
+      if (RelativeError(truth, fit.lights.Irradiance(normals)).mean < 0.05) reached.io = n;
     }
     for (int n = 1; n <= 64 && reached.median_cut == 0; ++n) {
-      if (RelativeError(truth, IrradianceOf(MedianCutLights(map, n), normals)).mean < 0.05) reached.median_cut = n;
+      if (RelativeError(truth, MedianCutLights(map, n).Irradiance(normals)).mean < 0.05) reached.median_cut = n;
     }
     std::printf("%-30s below 5%% mean error: irradiance optimization %d lights, median cut %d\n", file.c_str(),
                 reached.io, reached.median_cut);
@@ -126,8 +121,8 @@ TEST(LightFitTest, ConvergesWith64And128Lights) {
   const std::vector<glm::dvec3> truth = ExactIrradiance(map, normals);
   for (const int n : {64, 128}) {
     const LightFitResult fit = IrradianceOptimization(map, n);
-    const ApproximationError io = RelativeError(truth, IrradianceOf(fit.lights, normals));
-    const ApproximationError mc = RelativeError(truth, IrradianceOf(MedianCutLights(map, n), normals));
+    const ApproximationError io = RelativeError(truth, fit.lights.Irradiance(normals));
+    const ApproximationError mc = RelativeError(truth, MedianCutLights(map, n).Irradiance(normals));
     std::printf("%d lights: %d iterations, %s; mean %.2f%% (median cut %.2f%%), max %.2f%% (%.2f%%)\n", n, fit.iterations,
                 fit.termination.c_str(), 100 * io.mean, 100 * mc.mean, 100 * io.max, 100 * mc.max);
     EXPECT_TRUE(fit.converged) << fit.termination;

@@ -44,6 +44,12 @@ glm::dvec3 LightSet::Irradiance(const glm::vec3& normal) const {
   return e;
 }
 
+std::vector<glm::dvec3> LightSet::Irradiance(const std::vector<glm::vec3>& normals) const {
+  std::vector<glm::dvec3> e(normals.size());
+  for (size_t i = 0; i < normals.size(); ++i) e[i] = Irradiance(normals[i]);
+  return e;
+}
+
 std::string LightSetJson(const LightSet& set) {
   const auto array = [](const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
   nlohmann::json lights = nlohmann::json::array();

@@ -27,6 +27,7 @@ struct LightSet {
   std::vector<DirectionalLight> lights;
 
   glm::dvec3 Irradiance(const glm::vec3& normal) const;
+  std::vector<glm::dvec3> Irradiance(const std::vector<glm::vec3>& normals) const;
 };
 
 // `daylit lights`' file format: {"ambient": [r, g, b], "lights": [{"direction": [x, y, z],

@@ -10,11 +10,6 @@
 namespace daylit::relight {
 namespace {
 
-std::vector<glm::dvec3> IrradianceOf(const LightSet& set, const std::vector<glm::vec3>& normals) {
-  std::vector<glm::dvec3> e(normals.size());
-  for (size_t i = 0; i < normals.size(); ++i) e[i] = set.Irradiance(normals[i]);
-  return e;
-}
 
 TEST(MedianCutTest, LightsCarryTheMapsPowerAndSplitItEvenly) {
   const scene::HdrImage map = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
@@ -61,7 +56,7 @@ TEST(MedianCutTest, ReproducesSeed002sErrorsOnGalileo) {
   const std::vector<glm::dvec3> truth = ExactIrradiance(map, normals);
   double previous = 1e9;
   for (const int levels : {3, 5, 7}) {
-    const ApproximationError e = RelativeError(truth, IrradianceOf(MedianCut(map, levels), normals));
+    const ApproximationError e = RelativeError(truth, MedianCut(map, levels).Irradiance(normals));
     std::printf("median cut, %d lights: mean %.1f%%, max %.1f%% over %zu normals\n", 1 << levels, 100 * e.mean,
                 100 * e.max, e.normals);
     if (levels == 3) {

@@ -41,6 +41,7 @@ struct LightsOptions {
   std::string methods = "mediancut,io,sh";
   std::optional<double> threshold;
   std::string out = "lights";
+  bool no_ambient = false;
 };
 
 struct Row {
@@ -90,15 +91,11 @@ std::vector<int> ParseCounts(const std::string& list, int max) {
   return counts;
 }
 
-std::vector<glm::dvec3> IrradianceOf(const relight::LightSet& set, const std::vector<glm::vec3>& normals) {
-  std::vector<glm::dvec3> e(normals.size());
-  for (size_t i = 0; i < normals.size(); ++i) e[i] = set.Irradiance(normals[i]);
-  return e;
-}
 
 class Approximator {
  public:
-  Approximator(const scene::HdrImage& map, fs::path out) : map_(map), out_(std::move(out)) {
+  Approximator(const scene::HdrImage& map, fs::path out, relight::LightFitOptions fit)
+      : map_(map), out_(std::move(out)), fit_(fit) {
     normals_ = relight::IcosahedronNormals(5);
     truth_ = relight::ExactIrradiance(map_, normals_);
   }
@@ -111,7 +108,7 @@ class Approximator {
     relight::LightSet set;
     std::string detail;
     if (method == "io") {
-      const relight::LightFitResult fit = relight::IrradianceOptimization(map_, n);
+      const relight::LightFitResult fit = relight::IrradianceOptimization(map_, n, fit_);
       set = fit.lights;
       if (!fit.converged) Log().warn("io, {} lights: not converged: {}", n, fit.termination);
       detail = fmt::format(", {} iterations", fit.iterations);
@@ -120,7 +117,7 @@ class Approximator {
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     WriteFileAtomically(out_ / fmt::format("lights_{}_{}.json", method, n), relight::LightSetJson(set));
-    Row row{method, n, relight::RelativeError(truth_, IrradianceOf(set, normals_))};
+    Row row{method, n, relight::RelativeError(truth_, set.Irradiance(normals_))};
     Log().debug("{}, {} lights: mean {:.2f}%, max {:.2f}% ({:.3f} s{})", method, n, 100 * row.error.mean,
                 100 * row.error.max, seconds, detail);
     return rows_.emplace(key, row).first->second;
@@ -166,6 +163,7 @@ class Approximator {
  private:
   const scene::HdrImage& map_;
   fs::path out_;
+  relight::LightFitOptions fit_;
   std::vector<glm::vec3> normals_;
   std::vector<glm::dvec3> truth_;
   std::map<std::pair<std::string, int>, Row> rows_;
@@ -225,7 +223,9 @@ void RunLights(const LightsOptions& o) {
   Log().info("{}: {}x{} lat-long{}", o.probe, probe.map.width, probe.map.height,
              probe.converted_from_angular ? " (converted from an angular map)" : "");
   fs::create_directories(o.out);
-  Approximator approximator(probe.map, o.out);
+  relight::LightFitOptions fit;
+  fit.ambient = !o.no_ambient;
+  Approximator approximator(probe.map, o.out, fit);
 
   std::vector<Row> rows;
   size_t jobs = 0;
@@ -308,6 +308,7 @@ void AddLightsCommand(CLI::App& app) {
   cmd->add_option("--threshold", options->threshold,
                   "Also find the smallest N whose mean error is below this (e.g. 0.05)");
   cmd->add_option("--out", options->out, "Output folder (default lights)");
+  cmd->add_flag("--no-ambient", options->no_ambient, "Irradiance optimization without the ambient term (seed 002's form)");
   cmd->callback([options] { RunLights(*options); });
 }
 
