@@ -8,6 +8,9 @@ extern "C" {
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstdarg>
+#include <string>
 
 #include "base/error.h"
 #include "base/log.h"
@@ -24,6 +27,16 @@ struct VideoDecoder::State {
   bool draining = false;
   int frames = 0;
   int errors = 0;
+  AVRational time_base{1, 1};
+  double fps = 0.0;        // frames per second of the stream
+  int64_t start_pts = 0;   // presentation time of frame 0
+  int last_index = -1;
+  int skip_until = -1;     // after Seek: frames before this are decoded and dropped
+
+  int IndexOf(int64_t pts) const {
+    if (pts == AV_NOPTS_VALUE || fps <= 0.0) return last_index + 1;
+    return static_cast<int>(std::llround(static_cast<double>(pts - start_pts) * av_q2d(time_base) * fps));
+  }
 
   ~State() {
     av_frame_free(&frame);
@@ -33,7 +46,25 @@ struct VideoDecoder::State {
   }
 };
 
+namespace {
+
+// libav's own messages ("Packet corrupt", "partial file") go to daylit's logger as debug lines;
+// the decoder reports what matters for the user itself (a frame skipped, the stream ending).
+void LogLibav(void* context, int level, const char* format, va_list args) {
+  if (level > av_log_get_level()) return;
+  char line[1024];
+  int print_prefix = 1;
+  av_log_format_line(context, level, format, args, line, sizeof(line), &print_prefix);
+  std::string text(line);
+  while (!text.empty() && text.back() == '\n') text.pop_back();
+  Log().debug("libav: {}", text);
+}
+
+}  // namespace
+
 VideoDecoder::VideoDecoder(const std::filesystem::path& path) : state_(std::make_unique<State>()) {
+  static const bool logging = (av_log_set_callback(LogLibav), true);
+  (void)logging;
   State& s = *state_;
   s.path = path;
   if (avformat_open_input(&s.format, path.c_str(), nullptr, nullptr) < 0) {
@@ -53,6 +84,28 @@ VideoDecoder::VideoDecoder(const std::filesystem::path& path) : state_(std::make
   }
   s.packet = av_packet_alloc();
   s.frame = av_frame_alloc();
+  const AVStream* stream = s.format->streams[s.stream];
+  s.time_base = stream->time_base;
+  // r_frame_rate: the rate every timestamp is a multiple of (the true rate of a constant-rate
+  // stream even when frames are missing, where avg_frame_rate would be lower).
+  const AVRational rate = stream->r_frame_rate.num > 0 ? stream->r_frame_rate : stream->avg_frame_rate;
+  s.fps = rate.den > 0 ? av_q2d(rate) : 0.0;
+  s.start_pts = stream->start_time == AV_NOPTS_VALUE ? 0 : stream->start_time;
+}
+
+int VideoDecoder::last_index() const { return state_->last_index; }
+
+void VideoDecoder::Seek(int index) {
+  State& s = *state_;
+  if (s.fps <= 0.0) ThrowInputError("{}: the stream has no frame rate; it cannot be sought", s.path.string());
+  const int64_t ts = s.start_pts + static_cast<int64_t>(std::llround(index / s.fps / av_q2d(s.time_base)));
+  if (av_seek_frame(s.format, s.stream, ts, AVSEEK_FLAG_BACKWARD) < 0) {
+    ThrowInputError("{}: cannot seek to frame {}", s.path.string(), index);
+  }
+  avcodec_flush_buffers(s.codec);
+  s.draining = false;
+  s.skip_until = index;
+  s.last_index = index - 1;
 }
 
 VideoDecoder::~VideoDecoder() = default;
@@ -67,7 +120,9 @@ bool VideoDecoder::Next(cv::Mat* rgb) {
   State& s = *state_;
   for (;;) {
     const int received = avcodec_receive_frame(s.codec, s.frame);
+    if (received == 0 && s.IndexOf(s.frame->best_effort_timestamp) < s.skip_until) continue;  // before a Seek's target
     if (received == 0) {
+      s.last_index = s.IndexOf(s.frame->best_effort_timestamp);
       if (s.frame->color_range == AVCOL_RANGE_JPEG || s.codec->pix_fmt == AV_PIX_FMT_YUVJ420P) {
         ThrowInputError("{}: full-range YUV is not supported (expected limited range)", s.path.string());
       }

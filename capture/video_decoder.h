@@ -32,6 +32,14 @@ class VideoDecoder {
   int frames_read() const;
   int errors() const;
 
+  // The frame number of the frame Next() returned last, from its presentation time and the
+  // stream's frame rate (0 for the first frame); a gap means frames that could not be decoded.
+  int last_index() const;
+  // Makes the next Next() return frame `index` (or the first after it that decodes): seeks to the
+  // key frame before it and decodes forward from there, so the frame is exactly as when read in
+  // order.
+  void Seek(int index);
+
  private:
   struct State;
   std::unique_ptr<State> state_;

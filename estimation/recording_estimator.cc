@@ -10,17 +10,15 @@
 #include <map>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "base/csv.h"
 #include "base/error.h"
 #include "base/log.h"
-#include "base/statistics.h"
 #include "base/progress.h"
-#include "capture/video_decoder.h"
+#include "base/statistics.h"
+#include "capture/frame_source.h"
 #include "report/plot.h"
-#include "scene/hdr_image.h"
 #include "sunmodel/solar_position.h"
 
 namespace daylit::estimation {
@@ -38,12 +36,13 @@ struct DecodedFrame {
   std::exception_ptr error;  // a failure that is not the frame's own: ends the run
 };
 
-// Reads the frames in order on its own thread, a few ahead of the estimation, so that decoding
-// and estimating overlap.
+// Reads the scene's frames (its FrameSource) in order on its own thread, a few ahead of the
+// estimation, so that decoding and estimating overlap. One result per row of frames.csv from
+// `first_row` on: a frame, or a frame that could not be read.
 class FramePipeline {
  public:
-  explicit FramePipeline(const scene::Scene& scene) : scene_(scene) {
-    if (scene.frames.kind == scene::FrameSourceKind::kVideo) video_ = std::make_unique<capture::VideoDecoder>(scene.frames.video);
+  explicit FramePipeline(const scene::Scene& scene, size_t first_row = 0) : source_(scene::OpenFrameSource(scene)) {
+    if (first_row > 0) source_->Seek(scene.frame_times->frames[first_row].index);
     queue_.set_capacity(4);
     thread_ = std::thread([this] { Run(); });
   }
@@ -65,17 +64,20 @@ class FramePipeline {
 
  private:
   void Run() {
-    const std::vector<capture::FrameTime>& times = scene_.frame_times->frames;
-    for (size_t i = 0; i < times.size() && !stop_; ++i) {
+    while (!stop_) {
       DecodedFrame frame;
+      bool end = false;
       try {
-        frame.ok = Read(times[i].index, &frame);
-      } catch (const InputError& e) {
-        Log().warn("{}", e.what());
-        frame.ok = false;
+        capture::Frame f;
+        const capture::FrameStatus status = source_->Next(&f);
+        end = status == capture::FrameStatus::kEnd;
+        frame.ok = status == capture::FrameStatus::kFrame;
+        frame.linear = f.linear;
+        frame.rgb = f.rgb;
       } catch (...) {
         frame.error = std::current_exception();
       }
+      if (end) return;
       const bool failed = static_cast<bool>(frame.error);
       try {
         queue_.push(std::move(frame));  // waits while the estimation is 4 frames behind
@@ -85,25 +87,8 @@ class FramePipeline {
       if (failed) return;
     }
   }
-  bool Read(int index, DecodedFrame* frame) {
-    if (video_) return video_->Next(&frame->rgb);
-    const std::filesystem::path path = scene_.frames.ImagePath(index);
-    if (path.extension() == ".exr") {
-      scene::HdrImage image = scene::ReadHdrImage(path);  // already linear
-      cv::Mat(image.height, image.width, CV_32FC3, image.rgb.data()).copyTo(frame->rgb);
-      frame->linear = true;
-      return true;
-    }
-    const cv::Mat bgr = cv::imread(path.string(), cv::IMREAD_COLOR);
-    if (bgr.empty()) return false;
-    cv::Mat rgb;
-    cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
-    rgb.convertTo(frame->rgb, CV_32FC3, 1.0 / 255.0);
-    return true;
-  }
 
-  const scene::Scene& scene_;
-  std::unique_ptr<capture::VideoDecoder> video_;
+  std::unique_ptr<capture::FrameSource> source_;
   tbb::concurrent_bounded_queue<DecodedFrame> queue_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
@@ -138,7 +123,10 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
     if (!decoded.ok || decoded.rgb.cols != bake.camera.width || decoded.rgb.rows != bake.camera.height) {
       row.decoded = false;
       ++run.undecodable;
-      Log().warn("{}: frame {} cannot be decoded; skipped", scene.file.string(), row.frame);
+      if (decoded.ok) {
+        Log().warn("{}: frame {} is {}x{}, not the camera's {}x{}; skipped", scene.file.string(), row.frame,
+                   decoded.rgb.cols, decoded.rgb.rows, bake.camera.width, bake.camera.height);
+      }
       const FilteredLight held = filter.Update(t_s, std::nullopt, 0.0);
       row.light = held.light, row.confidence = held.confidence;
       run.frames.push_back(row);
@@ -180,8 +168,8 @@ FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, const 
   }
   DecodedFrame decoded;
   {
-    FramePipeline frames(scene);
-    for (size_t i = 0; i <= position; ++i) decoded = frames.Next();
+    FramePipeline frames(scene, position);
+    decoded = frames.Next();
   }
   FrameFit out;
   out.row.frame = times[position].index;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "base/utc_time.h"
+#include "capture/frame_source.h"
 #include "capture/frame_times.h"
 #include "capture/response.h"
 #include "scene/camera.h"
@@ -103,5 +105,9 @@ struct Scene {
 // Loads `path` (a scene.json, or a recording folder holding one), the OBJ model it names and
 // its frames.csv, and checks every field. Throws InputError "<file>: <field>: <problem>".
 Scene LoadScene(const std::filesystem::path& path);
+
+// The scene's frames as a FrameSource: its video or image sequence with frames.csv (exposures
+// falling back to camera.exposure), or its live device.
+std::unique_ptr<capture::FrameSource> OpenFrameSource(const Scene& scene);
 
 }  // namespace daylit::scene

@@ -3,6 +3,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "capture/frame_source.h"
 #include "scene/json_fields.h"
 #include "scene/scene.h"
 
@@ -338,13 +339,17 @@ void LoadGroundTruth(const JsonField& root, Scene* scene) {
 
 }  // namespace
 
-fs::path FramesSpec::ImagePath(int index) const {
-  const size_t percent = image_pattern.find('%');
-  const size_t d = image_pattern.find('d', percent);
-  const std::string spec = image_pattern.substr(percent + 1, d - percent - 1);  // "", "06", "6"
-  const int width = spec.empty() ? 0 : std::stoi(spec);
-  return image_pattern.substr(0, percent) + fmt::format("{:0{}d}", index, width) +
-         image_pattern.substr(d + 1);
+fs::path FramesSpec::ImagePath(int index) const { return capture::FramePath(image_pattern, index); }
+
+std::unique_ptr<capture::FrameSource> OpenFrameSource(const Scene& scene) {
+  switch (scene.frames.kind) {
+    case FrameSourceKind::kVideo: return capture::OpenVideoSource(scene.frames.video, *scene.frame_times, scene.exposure);
+    case FrameSourceKind::kImages:
+      return capture::OpenImageSequence(scene.frames.image_pattern, *scene.frame_times, scene.exposure);
+    case FrameSourceKind::kDevice: break;
+  }
+  ThrowInputError("{}: frames: the live device {} is read by daylit live and daylit record", scene.file.string(),
+                  scene.frames.device);
 }
 
 double VirtualObject::BoundingRadius() const {

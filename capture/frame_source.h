@@ -1,0 +1,68 @@
+// One interface for every source of frames: recorded videos, image sequences and live V4L2
+// cameras. The pipeline reads frames through it and cannot tell them apart.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "base/utc_time.h"
+#include "capture/frame_times.h"
+
+namespace daylit::capture {
+
+struct Frame {
+  int index = 0;         // frames.csv's frame number; a live source counts from 0
+  UtcTime utc;           // when the frame was exposed
+  double exposure = 1.0;  // k: linear pixel = k · radiance
+  cv::Mat rgb;           // CV_32FC3, R, G, B
+  bool linear = false;   // true: linear light (EXR); false: encoded by the camera response
+};
+
+enum class FrameStatus {
+  kFrame,        // `frame` holds the next frame
+  kUndecodable,  // the next frame could not be read: `frame` names it (index, time), no pixels
+  kWaiting,      // a live source has no frame now (device gone, retrying); call again
+  kEnd,          // no more frames
+};
+
+struct SourceStats {
+  int delivered = 0;    // frames returned
+  int undecodable = 0;  // frames that could not be decoded or read
+  int dropped = 0;      // live: frames the driver's sequence numbers show were never delivered
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  virtual FrameStatus Next(Frame* frame) = 0;
+  // Recorded sources: the next Next() returns frame `index` (frames.csv's numbering). Throws
+  // InputError for an index not in the recording, or for a live source.
+  virtual void Seek(int index) = 0;
+  virtual std::string Describe() const = 0;
+  virtual bool live() const { return false; }
+  const SourceStats& stats() const { return stats_; }
+
+ protected:
+  SourceStats stats_;
+};
+
+// A video file (decoded exactly by VideoDecoder) with its frames.csv; `exposure` where a row
+// has none. Frames the decoder cannot produce are kUndecodable, named by their row.
+std::unique_ptr<FrameSource> OpenVideoSource(const std::filesystem::path& video, FrameTimes times, double exposure);
+
+// Images named by `pattern` (one %d or %0Nd for the frame number; PNG/JPEG encoded, EXR
+// linear) with their frames.csv. A missing or unreadable image is kUndecodable, with a warning
+// naming the file.
+std::unique_ptr<FrameSource> OpenImageSequence(std::string pattern, FrameTimes times, double exposure);
+
+// The file of frame `index` for an image pattern.
+std::filesystem::path FramePath(const std::string& pattern, int index);
+
+// `source` paced to its timestamps: each frame is returned no earlier than its time after the
+// first frame's, divided by `speed`, on the steady clock (for replay in a window).
+std::unique_ptr<FrameSource> Paced(std::unique_ptr<FrameSource> source, double speed);
+
+}  // namespace daylit::capture
