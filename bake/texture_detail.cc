@@ -24,12 +24,13 @@ constexpr int kMinSamples = 3;  // usable frames needed for a pixel's median
 cv::Mat Linearize(const cv::Mat& frame, const capture::CameraResponse& response) {
   cv::Mat out(frame.size(), CV_32FC3);
   if (frame.depth() == CV_32F) return frame;
-  const std::array<float, 256> lut = response.LinearLut8();
+  // BGR: channel c of the image is response channel 2 − c.
+  const std::array<std::array<float, 256>, 3> lut = {response.LinearLut8(2), response.LinearLut8(1), response.LinearLut8(0)};
   for (int y = 0; y < frame.rows; ++y) {
     const cv::Vec3b* in = frame.ptr<cv::Vec3b>(y);
     cv::Vec3f* o = out.ptr<cv::Vec3f>(y);
     for (int x = 0; x < frame.cols; ++x) {
-      for (int c = 0; c < 3; ++c) o[x][c] = in[x][c] >= 250 || in[x][c] <= 3 ? NAN : lut[in[x][c]];
+      for (int c = 0; c < 3; ++c) o[x][c] = in[x][c] >= 250 || in[x][c] <= 3 ? NAN : lut[static_cast<size_t>(c)][in[x][c]];
     }
   }
   return out;

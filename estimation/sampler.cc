@@ -105,7 +105,7 @@ std::vector<Sample> Sampler::Draw(const cv::Mat& frame, double exposure, const c
     for (size_t k = 0; k < stratum.size() && taken < quota; ++k) {
       const uint32_t i = stratum[k].pixel;
       cv::Vec3f p = frame.at<cv::Vec3f>(static_cast<int>(i / gbuffer_.width), static_cast<int>(i % gbuffer_.width));
-      if (linearizer != nullptr) p = cv::Vec3f((*linearizer)(p[0]), (*linearizer)(p[1]), (*linearizer)(p[2]));
+      if (linearizer != nullptr) p = cv::Vec3f((*linearizer)(p[0], 0), (*linearizer)(p[1], 1), (*linearizer)(p[2], 2));
       bool usable = true;
       for (int c = 0; c < 3; ++c) usable = usable && p[c] < options_.saturated && p[c] > options_.near_black;
       if (!usable) continue;

@@ -69,7 +69,7 @@ void LoadModelAndSurfaces(const JsonField& root, Scene* scene) {
   }
 }
 
-capture::CameraResponse LoadResponse(const JsonField& field) {
+capture::CameraResponse LoadResponse(const Scene& scene, const JsonField& field) {
   capture::CameraResponse response;
   if (field.IsString()) {
     const std::string name = field.String();
@@ -80,7 +80,12 @@ capture::CameraResponse LoadResponse(const JsonField& field) {
     }
     field.Fail(fmt::format("'{}' is not a response: use \"linear\", \"srgb\" or {{\"gamma\": g}}", name));
   }
-  if (!field.IsObject()) field.Fail("expected \"linear\", \"srgb\" or {\"gamma\": g}");
+  if (!field.IsObject()) field.Fail("expected \"linear\", \"srgb\", {\"gamma\": g} or {\"curve\": \"response.csv\"}");
+  if (auto curve = field.Find("curve")) {
+    response.curve = capture::ResponseCurve::kTable;
+    response.table = capture::ReadResponseTable(RequireFile(scene, *curve));
+    return response;
+  }
   const JsonField gamma = field.Get("gamma");
   response.curve = capture::ResponseCurve::kGamma;
   response.gamma = gamma.Number();
@@ -149,7 +154,7 @@ void LoadCamera(const JsonField& root, Scene* scene) {
       d->Fail(fmt::format("expected 4, 5, 8, 12 or 14 coefficients (k1, k2, p1, p2, k3, ...), got {}", n));
     }
   }
-  if (auto response = camera.Find("response")) scene->response = LoadResponse(*response);
+  if (auto response = camera.Find("response")) scene->response = LoadResponse(*scene, *response);
   if (auto exposure = camera.Find("exposure")) {
     scene->exposure = exposure->Number();
     if (scene->exposure <= 0.0) exposure->Fail(fmt::format("must be > 0 (got {})", scene->exposure));
