@@ -2,6 +2,10 @@
 
 #include <unistd.h>
 
+#include <cmath>
+
+#include <fmt/format.h>
+
 #include "base/error.h"
 #include "scene/scene.h"
 #include "scene/scene_test_util.h"
@@ -108,6 +112,20 @@ TEST(SceneLoaderTest, ImageSequenceAndLiveDeviceSources) {
   EXPECT_EQ(live.frames.device, "/dev/video0");
   EXPECT_EQ(live.frames.fps, 25.0);
   EXPECT_FALSE(live.frame_times.has_value());
+}
+
+TEST(SceneLoaderTest, ACalibratedResponseCurveIsReadFromItsFile) {
+  SceneSandbox sandbox("curve");
+  std::string csv = "code,r,g,b\n";
+  for (int i = 0; i < 256; ++i) csv += fmt::format("{},{},{},{}\n", i, 2.0 * i * i, i * i, 0.5 * i * i);
+  sandbox.WriteText("response.csv", csv);
+  sandbox.json()["camera"]["response"] = {{"curve", "response.csv"}};
+  const Scene scene = LoadScene(sandbox.Write());
+  ASSERT_EQ(scene.response.curve, capture::ResponseCurve::kTable);
+  // Each channel scaled to 1 at code 255: all three are (code / 255)² here.
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(scene.response.ToLinear(128.0 / 255.0, c), std::pow(128.0 / 255.0, 2.0), 1e-9);
+  sandbox.json()["camera"]["response"] = {{"curve", "missing.csv"}};
+  EXPECT_THROW(LoadScene(sandbox.Write()), InputError);
 }
 
 struct BadScene {

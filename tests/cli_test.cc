@@ -265,6 +265,36 @@ TEST(CliTest, LightsWritesTheLightsTheirErrorsAndTheAutomaticN) {
   fs::remove_all(out);
 }
 
+TEST(CliTest, CalibrateResponseWritesATableTheSceneCanName) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_response_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  // A gamma-2.2 camera photographing a ramp over three decades at four exposures.
+  std::string images;
+  for (int k = 0; k < 4; ++k) {
+    cv::Mat bgr(64, 300, CV_8UC3);
+    for (int y = 0; y < bgr.rows; ++y) {
+      for (int x = 0; x < bgr.cols; ++x) {
+        const double linear = std::pow(10.0, 3.0 * x / (bgr.cols - 1.0) - 2.5 + 0.6 * k) * (0.8 + 0.2 * std::sin(0.5 * y));
+        const auto code = static_cast<uint8_t>(std::lround(255.0 * std::pow(std::min(linear, 1.0), 1.0 / 2.2)));
+        bgr.at<cv::Vec3b>(y, x) = cv::Vec3b(code, code, code);
+      }
+    }
+    const fs::path file = dir / ("bracket" + std::to_string(k) + ".png");
+    ASSERT_TRUE(cv::imwrite(file.string(), bgr));
+    images.append(" ").append(file.string());
+  }
+  const fs::path out = dir / "response.csv";
+  std::string args = "calibrate-response";
+  args.append(images).append(" --times 1,3.981,15.85,63.1 --out ").append(out.string());
+  const CliRun run = Daylit(args);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto table = capture::ReadResponseTable(out);
+  // Gamma 2.2: code 128 is 0.22 of code 255.
+  EXPECT_NEAR(table->linear[1][128], std::pow(128.0 / 255.0, 2.2), 0.03);
+  EXPECT_TRUE(fs::is_regular_file(dir / "response.png"));
+  fs::remove_all(dir);
+}
+
 TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
   scene::testing::SceneSandbox sandbox("cli");
   sandbox.WriteText("broken.json", "{\"format\": \"daylit-recording/1\",");
@@ -293,6 +323,10 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"lights " + kProbe + " --method kmeans --out " + dir + "/l", "--method: 'kmeans' is not one of mediancut, io, sh"},
       {"lights " + kProbe + " --threshold 5 --out " + dir + "/l", "--threshold: 5 is not a mean relative error in (0, 1)"},
       {"lights " + dir + "/broken.json --out " + dir + "/l", "broken.json"},
+      {"calibrate-response " + kProbe + " " + kProbe + " --times 1", "--times: 1 exposure times for 2 images"},
+      {"calibrate-response " + dir + "/none.png " + dir + "/none.png --times 1,2", "none.png: no such file"},
+      {"calibrate-camera " + dir + "/broken.json --board 9by6", "--board: '9by6' is not COLSxROWS"},
+      {"calibrate-camera " + dir + "/broken.json", "broken.json: cannot be decoded as an image"},
   };
   for (const BadCall& call : calls) {
     const CliRun run = Daylit(call.args);  // NOLINT

@@ -12,5 +12,6 @@ void AddBakeCommand(CLI::App& app);
 void AddEstimateCommand(CLI::App& app);
 void AddRelightEnvCommand(CLI::App& app);
 void AddLightsCommand(CLI::App& app);
+void AddCalibrateCommands(CLI::App& app);
 
 }  // namespace daylit::app

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   daylit::app::AddEstimateCommand(app);
   daylit::app::AddRelightEnvCommand(app);
   daylit::app::AddLightsCommand(app);
+  daylit::app::AddCalibrateCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
