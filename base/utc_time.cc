@@ -173,4 +173,20 @@ std::string FormatUtcTime(const UtcTime& utc, int decimals) {
                      t.hour, t.minute, second, width, decimals);
 }
 
+UtcTime UtcFromUnixSeconds(double seconds) {
+  const double days = std::floor(seconds / 86400.0);
+  double rest = seconds - days * 86400.0;
+  UtcTime utc;
+  CivilFromDays(static_cast<int64_t>(days), &utc.year, &utc.month, &utc.day);
+  utc.hour = std::min(23, static_cast<int>(rest / 3600.0));
+  rest -= utc.hour * 3600.0;
+  utc.minute = std::min(59, static_cast<int>(rest / 60.0));
+  utc.second = rest - utc.minute * 60.0;
+  return utc;
+}
+
+double UnixSeconds(const UtcTime& utc) {
+  return static_cast<double>(utc.UnixDay()) * 86400.0 + utc.hour * 3600.0 + utc.minute * 60.0 + utc.second;
+}
+
 }  // namespace daylit

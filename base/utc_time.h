@@ -35,6 +35,10 @@ UtcTime ParseUtcTime(std::string_view text, std::string_view where);
 // "2026-06-21T05:00:00.000Z" with `decimals` digits of the second (0..9).
 std::string FormatUtcTime(const UtcTime& utc, int decimals = 3);
 
+// The instant `seconds` after 1970-01-01T00:00:00Z (POSIX time: no leap seconds), and back.
+UtcTime UtcFromUnixSeconds(double seconds);
+double UnixSeconds(const UtcTime& utc);
+
 // Proleptic Gregorian calendar <-> days since 1970-01-01 (H. Hinnant's civil-day algorithms).
 int64_t DaysFromCivil(int year, int month, int day);
 void CivilFromDays(int64_t days, int* year, int* month, int* day);

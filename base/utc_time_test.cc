@@ -9,6 +9,14 @@
 namespace daylit {
 namespace {
 
+TEST(UtcTimeTest, UnixSecondsRoundTrip) {
+  EXPECT_EQ(FormatUtcTime(UtcFromUnixSeconds(0.0)), "1970-01-01T00:00:00.000Z");
+  EXPECT_EQ(FormatUtcTime(UtcFromUnixSeconds(1700000000.25)), "2023-11-14T22:13:20.250Z");  // a well-known instant
+  const UtcTime t = ParseUtcTime("2026-06-21T05:00:00.125Z", "test");
+  EXPECT_DOUBLE_EQ(UnixSeconds(t), 1782018000.125);
+  EXPECT_EQ(UtcFromUnixSeconds(UnixSeconds(t)).SecondsSince(t), 0.0);
+}
+
 TEST(UtcTimeTest, ParsesZuluWithFraction) {
   const UtcTime t = ParseUtcTime("2026-06-21T05:00:00.100Z", "test");
   EXPECT_EQ(t.year, 2026);

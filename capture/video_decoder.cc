@@ -62,9 +62,13 @@ void LogLibav(void* context, int level, const char* format, va_list args) {
 
 }  // namespace
 
+void RouteLibavLogging() {
+  static const bool routed = (av_log_set_callback(LogLibav), true);
+  (void)routed;
+}
+
 VideoDecoder::VideoDecoder(const std::filesystem::path& path) : state_(std::make_unique<State>()) {
-  static const bool logging = (av_log_set_callback(LogLibav), true);
-  (void)logging;
+  RouteLibavLogging();
   State& s = *state_;
   s.path = path;
   if (avformat_open_input(&s.format, path.c_str(), nullptr, nullptr) < 0) {

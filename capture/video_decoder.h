@@ -45,6 +45,9 @@ class VideoDecoder {
   std::unique_ptr<State> state_;
 };
 
+// Sends libav's own messages to daylit's logger (debug level) instead of stderr; idempotent.
+void RouteLibavLogging();
+
 // Planar 8-bit YUV 4:2:0 (limited range) to encoded RGB floats; `bt709` selects the matrix.
 // Exposed for tests. Chroma sample (i, j) sits at luma (2i, 2j + 0.5).
 void Yuv420ToRgb(const uint8_t* y, int y_stride, const uint8_t* u, int u_stride, const uint8_t* v, int v_stride,

@@ -14,6 +14,7 @@
 #include "capture/frame_source.h"
 #include "capture/frame_times.h"
 #include "capture/response.h"
+#include "capture/v4l2_source.h"
 #include "scene/camera.h"
 #include "scene/model.h"
 #include "sunmodel/geo_frame.h"
@@ -39,6 +40,7 @@ struct FramesSpec {
   std::filesystem::path timestamps;  // kVideo, kImages
   std::string device;                // kDevice, e.g. /dev/video0
   double fps = 30.0;                 // kDevice
+  capture::CameraSettings controls;  // kDevice: exposure, gain, white balance (absent: held from auto)
 
   // The image file of frame `index` (kImages only).
   std::filesystem::path ImagePath(int index) const;

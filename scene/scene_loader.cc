@@ -4,6 +4,7 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "capture/frame_source.h"
+#include "capture/v4l2_source.h"
 #include "scene/json_fields.h"
 #include "scene/scene.h"
 
@@ -195,7 +196,7 @@ bool IsFramePattern(const std::string& pattern) {
 
 void LoadFrames(const JsonField& root, Scene* scene) {
   const JsonField frames = root.Get("frames");
-  frames.WarnUnknownKeys({"video", "images", "timestamps", "device", "fps"});
+  frames.WarnUnknownKeys({"video", "images", "timestamps", "device", "fps", "controls"});
   FramesSpec& spec = scene->frames;
   const int kinds = frames.Has("video") + frames.Has("images") + frames.Has("device");
   if (kinds != 1) frames.Fail("give exactly one of \"video\", \"images\" or \"device\"");
@@ -205,6 +206,18 @@ void LoadFrames(const JsonField& root, Scene* scene) {
     if (auto fps = frames.Find("fps")) {
       spec.fps = fps->Number();
       if (spec.fps <= 0.0 || spec.fps > 1000.0) fps->Fail(fmt::format("{} is outside (0, 1000]", spec.fps));
+    }
+    if (auto controls = frames.Find("controls")) {
+      controls->WarnUnknownKeys({"exposure_100us", "gain", "white_balance_k"});
+      const auto integer = [&](const char* key, std::optional<int64_t>* out) {
+        if (auto f = controls->Find(key)) {
+          *out = f->Integer();
+          if (**out < 0) f->Fail(fmt::format("{} is negative", **out));
+        }
+      };
+      integer("exposure_100us", &spec.controls.exposure_100us);
+      integer("gain", &spec.controls.gain);
+      integer("white_balance_k", &spec.controls.white_balance_k);
     }
     return;
   }
@@ -353,8 +366,12 @@ std::unique_ptr<capture::FrameSource> OpenFrameSource(const Scene& scene) {
       return capture::OpenImageSequence(scene.frames.image_pattern, *scene.frame_times, scene.exposure);
     case FrameSourceKind::kDevice: break;
   }
-  ThrowInputError("{}: frames: the live device {} is read by daylit live and daylit record", scene.file.string(),
-                  scene.frames.device);
+  capture::V4l2Options options;
+  options.width = scene.intrinsics.width, options.height = scene.intrinsics.height;
+  options.fps = scene.frames.fps;
+  options.settings = scene.frames.controls;
+  options.exposure = scene.exposure;
+  return capture::OpenV4l2Source(scene.frames.device, options);
 }
 
 double VirtualObject::BoundingRadius() const {

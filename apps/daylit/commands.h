@@ -13,5 +13,6 @@ void AddEstimateCommand(CLI::App& app);
 void AddRelightEnvCommand(CLI::App& app);
 void AddLightsCommand(CLI::App& app);
 void AddCalibrateCommands(CLI::App& app);
+void AddRecordCommand(CLI::App& app);
 
 }  // namespace daylit::app

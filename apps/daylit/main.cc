@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   daylit::app::AddRelightEnvCommand(app);
   daylit::app::AddLightsCommand(app);
   daylit::app::AddCalibrateCommands(app);
+  daylit::app::AddRecordCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,179 @@
+// daylit record: a live camera (or another recording's frames) written as a recording folder
+// that daylit replays later (docs/capture.md, docs/recording-format.md).
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "apps/daylit/commands.h"
+#include "base/atomic_file.h"
+#include "base/csv.h"
+#include "base/error.h"
+#include "base/log.h"
+#include "base/progress.h"
+#include "base/statistics.h"
+#include "capture/recording_writer.h"
+#include "capture/v4l2_source.h"
+#include "scene/scene.h"
+
+namespace daylit::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::atomic<bool> g_stop{false};
+extern "C" void StopRecording(int) { g_stop = true; }
+
+struct RecordOptions {
+  std::string device;
+  std::string from;
+  std::string scene;
+  std::string out;
+  std::optional<int> frames;
+  std::optional<double> seconds;
+  bool images = false;
+};
+
+// Copies a file scene.json names into the new folder (keeping its name) and returns the new
+// relative path.
+std::string CopyInto(const fs::path& source_dir, const std::string& relative, const fs::path& out) {
+  const fs::path from = source_dir / relative;
+  fs::path to = fs::path(relative).lexically_normal();
+  if (to.is_absolute() || to.string().rfind("..", 0) == 0) to = to.filename();
+  fs::create_directories((out / to).parent_path());
+  fs::copy_file(from, out / to, fs::copy_options::overwrite_existing);
+  return to.generic_string();
+}
+
+// scene.json for the new folder: the source's, with its files copied along, the frames replaced
+// and the ground truth (which describes other frames) left out.
+nlohmann::json NewSceneJson(const scene::Scene& scene, const capture::RecordingWriter& writer, const fs::path& out) {
+  nlohmann::json json = nlohmann::json::parse(ReadTextFile(scene.file));
+  const fs::path dir = scene.file.parent_path();
+  const auto copy = [&](nlohmann::json& field) {
+    if (field.is_string()) field = CopyInto(dir, field.get<std::string>(), out);
+  };
+  if (json.contains("model")) copy(json["model"]["file"]);
+  if (json.contains("envmap")) copy(json["envmap"]["file"]);
+  if (json.contains("diffuse_mask")) copy(json["diffuse_mask"]);
+  if (json.contains("camera") && json["camera"].contains("response") && json["camera"]["response"].is_object() &&
+      json["camera"]["response"].contains("curve")) {
+    copy(json["camera"]["response"]["curve"]);
+  }
+  if (json.contains("objects")) {
+    for (nlohmann::json& o : json["objects"]) {
+      if (o.contains("mesh") && o["mesh"].is_string() && o["mesh"].get<std::string>().rfind("builtin:", 0) != 0) copy(o["mesh"]);
+    }
+  }
+  json.erase("groundtruth");
+  json["frames"] = nlohmann::json::parse(writer.FramesJson());
+  return json;
+}
+
+void RunRecord(const RecordOptions& o) {
+  if (o.device.empty() == o.from.empty()) ThrowInputError("record: give exactly one of --device and --from");
+  if (o.device.empty() ? false : o.scene.empty()) ThrowInputError("--scene: needed with --device (the model, camera and location)");
+  if (o.frames && *o.frames < 1) ThrowInputError("--frames: {} is not a number of frames", *o.frames);
+  if (o.seconds && !(*o.seconds > 0.0)) ThrowInputError("--seconds: {} is not a duration", *o.seconds);
+  const fs::path out(o.out);
+  if (fs::exists(out) && !(fs::is_directory(out) && fs::is_empty(out))) {
+    ThrowInputError("--out: {} exists; record into a new folder", out.string());
+  }
+  const scene::Scene scene = scene::LoadScene(o.scene.empty() ? o.from : o.scene);
+  std::unique_ptr<capture::FrameSource> source;
+  double fps = 30.0;
+  std::optional<size_t> total;
+  if (!o.device.empty()) {
+    capture::V4l2Options v4l2;
+    v4l2.width = scene.intrinsics.width, v4l2.height = scene.intrinsics.height;
+    v4l2.fps = scene.frames.kind == scene::FrameSourceKind::kDevice ? scene.frames.fps : 30.0;
+    if (scene.frames.kind == scene::FrameSourceKind::kDevice) v4l2.settings = scene.frames.controls;
+    v4l2.exposure = scene.exposure;
+    source = capture::OpenV4l2Source(o.device, v4l2);
+    fps = v4l2.fps;
+  } else {
+    if (!scene.frame_times) ThrowInputError("--from: {} has no recorded frames", o.from);
+    source = scene::OpenFrameSource(scene);
+    // The video's nominal rate: the median step between frames (a recording may come in bursts).
+    const auto& times = scene.frame_times->frames;
+    std::vector<double> steps;
+    for (size_t i = 1; i < times.size(); ++i) steps.push_back(times[i].utc.SecondsSince(times[i - 1].utc));
+    const double step = MedianInPlace(steps, 1.0 / 30.0);
+    if (step > 0.0) fps = 1.0 / step;
+    total = times.size();
+  }
+  if (o.frames) total = total ? std::min(*total, static_cast<size_t>(*o.frames)) : static_cast<size_t>(*o.frames);
+  Log().info("recording {} into {}", source->Describe(), out.string());
+
+  const fs::path partial = fs::path(out.string() + ".partial");
+  fs::remove_all(partial);
+  capture::RecordingWriter writer(partial, o.images, fps, scene.response);
+  g_stop = false;
+  std::signal(SIGINT, StopRecording);
+  std::signal(SIGTERM, StopRecording);
+  std::optional<Progress> progress;
+  if (total) progress.emplace("record", *total);
+  std::optional<UtcTime> first;
+  const auto start = std::chrono::steady_clock::now();
+  int written = 0;
+  while (!g_stop && (!o.frames || written < *o.frames)) {
+    capture::Frame frame;
+    const capture::FrameStatus status = source->Next(&frame);
+    if (status == capture::FrameStatus::kEnd) break;
+    if (status == capture::FrameStatus::kWaiting) continue;
+    if (status == capture::FrameStatus::kUndecodable) {
+      if (progress) progress->Advance();
+      continue;
+    }
+    if (!first) first = frame.utc;
+    if (o.seconds && frame.utc.SecondsSince(*first) > *o.seconds) break;
+    writer.Write(frame);
+    ++written;
+    if (progress) {
+      progress->Advance();
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      progress->SetSuffix(fmt::format("{:.0f} fps", written / std::max(elapsed, 1e-9)));
+    }
+  }
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  progress.reset();
+  if (written == 0) {
+    fs::remove_all(partial);
+    ThrowInputError("record: no frame could be read from {}", source->Describe());
+  }
+  writer.Finish();
+  WriteFileAtomically(partial / "scene.json", NewSceneJson(scene, writer, partial).dump(2) + "\n");
+  fs::remove(out);  // an empty folder, if any
+  fs::rename(partial, out);
+  const capture::SourceStats& stats = source->stats();
+  fmt::print("{} frames written to {}; {} could not be decoded, {} dropped by the driver\n", written, out.string(),
+             stats.undecodable, stats.dropped);
+  if (stats.undecodable + stats.dropped > 0) {
+    Log().warn("{} frames could not be decoded and {} were dropped", stats.undecodable, stats.dropped);
+  }
+}
+
+}  // namespace
+
+void AddRecordCommand(CLI::App& app) {
+  auto options = std::make_shared<RecordOptions>();
+  CLI::App* cmd = app.add_subcommand("record", "Write a live camera (or a recording's frames) as a recording folder");
+  cmd->add_option("--device", options->device, "V4L2 camera, e.g. /dev/video0");
+  cmd->add_option("--from", options->from, "A recording whose frames to write instead (to cut or convert it)");
+  cmd->add_option("--scene", options->scene, "scene.json with the model, camera and location (default: --from's)");
+  cmd->add_option("--out", options->out, "New recording folder")->required();
+  cmd->add_option("--frames", options->frames, "Stop after this many frames");
+  cmd->add_option("--seconds", options->seconds, "Stop after this many seconds of frames");
+  cmd->add_flag("--images", options->images, "Lossless PNG frames instead of an H.264 video");
+  cmd->callback([options] { RunRecord(*options); });
+}
+
+}  // namespace daylit::app
