@@ -31,18 +31,22 @@ double Median(std::vector<double> v) { return MedianInPlace(v, static_cast<doubl
 // One frame as the estimator reads it: encoded RGB floats (video, PNG, JPEG) or linear ones (EXR).
 struct DecodedFrame {
   bool ok = false;
+  bool end = false;  // the source has no more frames
   bool linear = false;
+  int index = 0;
+  UtcTime utc;
+  double exposure = 1.0;
   cv::Mat rgb;
   std::exception_ptr error;  // a failure that is not the frame's own: ends the run
 };
 
 // Reads the scene's frames (its FrameSource) in order on its own thread, a few ahead of the
-// estimation, so that decoding and estimating overlap. One result per row of frames.csv from
-// `first_row` on: a frame, or a frame that could not be read.
+// estimation, so that decoding and estimating overlap. One result per frame from `first_row` on
+// (a frame, or one that could not be read), then one saying the end. While a live camera is gone
+// nothing comes, and the estimate holds.
 class FramePipeline {
  public:
-  explicit FramePipeline(const scene::Scene& scene, size_t first_row = 0) : source_(scene::OpenFrameSource(scene)) {
-    if (first_row > 0) source_->Seek(scene.frame_times->frames[first_row].index);
+  explicit FramePipeline(std::unique_ptr<capture::FrameSource> source) : source_(std::move(source)) {
     queue_.set_capacity(4);
     thread_ = std::thread([this] { Run(); });
   }
@@ -70,15 +74,17 @@ class FramePipeline {
       try {
         capture::Frame f;
         const capture::FrameStatus status = source_->Next(&f);
+        if (status == capture::FrameStatus::kWaiting) continue;
         end = status == capture::FrameStatus::kEnd;
+        frame.end = end;
         frame.ok = status == capture::FrameStatus::kFrame;
         frame.linear = f.linear;
+        frame.index = f.index, frame.utc = f.utc, frame.exposure = f.exposure;
         frame.rgb = f.rgb;
       } catch (...) {
         frame.error = std::current_exception();
       }
-      if (end) return;
-      const bool failed = static_cast<bool>(frame.error);
+      const bool failed = static_cast<bool>(frame.error) || end;
       try {
         queue_.push(std::move(frame));  // waits while the estimation is 4 frames behind
       } catch (const tbb::user_abort&) {
@@ -97,7 +103,11 @@ class FramePipeline {
 }  // namespace
 
 EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& bake, const EstimateOptions& options) {
-  if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames to estimate", scene.file.string());
+  return EstimateRecording(scene, bake, options, scene::OpenFrameSource(scene));
+}
+
+EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& bake, const EstimateOptions& options,
+                              std::unique_ptr<capture::FrameSource> source) {
   const scene::RayCaster caster(scene.model);
   const glm::vec3 capture = scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f);
   Sampler sampler(bake, capture, caster, options.sampler);
@@ -105,21 +115,29 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
   const capture::Linearizer linearizer(scene.response);
   const sunmodel::Atmosphere atmosphere = sunmodel::Atmosphere::Standard(scene.location.elevation_m);
   const sunmodel::SceneGeoFrame geo = scene.GeoFrame();
-  const std::vector<capture::FrameTime>& times = scene.frame_times->frames;
   EstimateRun run;
-  Progress progress("estimate", times.size());
+  // A recording's length is known; a live camera's is --frames, else until stopped.
+  std::optional<size_t> total;
+  if (scene.frame_times) total = scene.frame_times->frames.size();
+  if (options.max_frames) total = std::min(total.value_or(SIZE_MAX), static_cast<size_t>(*options.max_frames));
+  std::optional<Progress> progress;
+  if (total) progress.emplace("estimate", *total);
   const Clock::time_point start = Clock::now();
   std::vector<double> frame_ms;  // estimation after decoding, frames without a sun move
-  FramePipeline frames(scene);
-  for (size_t i = 0; i < times.size(); ++i) {
+  FramePipeline frames(std::move(source));
+  std::optional<UtcTime> first;
+  for (size_t i = 0; !total || i < *total; ++i) {
+    if (options.stop != nullptr && options.stop->load()) break;
     const DecodedFrame decoded = frames.Next();
+    if (decoded.end) break;
     FrameEstimate row;
-    row.frame = times[i].index;
-    row.time_utc = times[i].utc;
-    const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(times[i].utc, scene.location, atmosphere, {});
+    row.frame = decoded.index;
+    row.time_utc = decoded.utc;
+    const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(decoded.utc, scene.location, atmosphere, {});
     row.sun_elevation_deg = sun.ApparentElevationDeg();
     row.sun_azimuth_deg = sun.azimuth_deg;
-    const double t_s = times[i].utc.SecondsSince(times.front().utc);
+    if (!first) first = decoded.utc;
+    const double t_s = decoded.utc.SecondsSince(*first);
     if (!decoded.ok || decoded.rgb.cols != bake.camera.width || decoded.rgb.rows != bake.camera.height) {
       row.decoded = false;
       ++run.undecodable;
@@ -130,13 +148,12 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
       const FilteredLight held = filter.Update(t_s, std::nullopt, 0.0);
       row.light = held.light, row.confidence = held.confidence;
       run.frames.push_back(row);
-      progress.Advance();
+      if (progress) progress->Advance();
       continue;
     }
     const Clock::time_point began = Clock::now();
     const bool moved = sampler.SetSun(glm::vec3(geo.DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg)));
-    const std::vector<Sample> samples = sampler.Draw(decoded.rgb, times[i].exposure.value_or(scene.exposure),
-                                                     decoded.linear ? nullptr : &linearizer);
+    const std::vector<Sample> samples = sampler.Draw(decoded.rgb, decoded.exposure, decoded.linear ? nullptr : &linearizer);
     const SunSkyFitSummary fit = FitSunSky(options.fit, samples);
     const FilteredLight filtered =
         filter.Update(t_s, fit.IsUsable() ? std::optional<SunSky>(fit.light) : std::nullopt, fit.confidence);
@@ -150,9 +167,16 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
     row.confidence = filtered.confidence;
     row.samples = static_cast<int>(samples.size());
     run.frames.push_back(row);
-    progress.Advance();
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    progress.SetSuffix(fmt::format("{:.0f} fps", static_cast<double>(i + 1) / std::max(elapsed, 1e-9)));
+    const double fps = static_cast<double>(i + 1) / std::max(elapsed, 1e-9);
+    if (progress) {
+      progress->Advance();
+      progress->SetSuffix(fmt::format("{:.0f} fps", fps));
+    } else if ((i + 1) % 100 == 0) {
+      Log().info("{} frames, {:.0f} fps; E_sun ({:.3g}, {:.3g}, {:.3g}), E_sky ({:.3g}, {:.3g}, {:.3g})", i + 1, fps,
+                 row.light.sun_rgb.x, row.light.sun_rgb.y, row.light.sun_rgb.z, row.light.sky_rgb.x,
+                 row.light.sky_rgb.y, row.light.sky_rgb.z);
+    }
   }
   run.median_frame_ms = Median(frame_ms);
   run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
@@ -168,7 +192,9 @@ FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, const 
   }
   DecodedFrame decoded;
   {
-    FramePipeline frames(scene, position);
+    std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
+    source->Seek(times[position].index);
+    FramePipeline frames(std::move(source));
     decoded = frames.Next();
   }
   FrameFit out;

@@ -3,7 +3,9 @@
 // temporal filter. Headless: no GL. The controller owns the loop; the estimators stay stateless.
 #pragma once
 
+#include <atomic>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,6 +22,8 @@ struct EstimateOptions {
   SamplerOptions sampler;
   SunSkyFitOptions fit;
   TemporalFilterOptions filter;
+  std::optional<int> max_frames;              // stop after this many (a live camera runs until stopped)
+  const std::atomic<bool>* stop = nullptr;    // set (e.g. by Ctrl-C) to end the run after the frame at hand
 };
 
 struct FrameEstimate {
@@ -41,9 +45,13 @@ struct EstimateRun {
   std::vector<double> sun_moves_ms;   // the frames with one: shadow rays, strata, transfer terms
 };
 
-// Runs over every frame of a recorded scene (video or images). Throws InputError for a scene
-// without recorded frames (a live device).
+// Runs over the frames of the scene's FrameSource: every frame of a recording (video or images),
+// or a live camera's until `max_frames` or `stop`. A frame that cannot be read holds the
+// estimate; while a camera is unplugged nothing comes, and the estimate holds too.
 EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& bake, const EstimateOptions& options);
+// The same from a source the caller opened (a camera checked before the bake, say).
+EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& bake, const EstimateOptions& options,
+                              std::unique_ptr<capture::FrameSource> source);
 
 // The unfiltered fit of one frame (its position in frames.csv), as the estimator makes it:
 // decodes the recording up to it. Throws InputError if the position is out of range or the frame

@@ -349,7 +349,11 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
   sandbox.json()["model"]["file"] = "nan.obj";
   const fs::path nan_scene = sandbox.Write();
   const std::string dir = sandbox.dir().string();
+  scene::testing::SceneSandbox live("cli_live");
+  live.json()["frames"] = {{"device", "/dev/video-daylit-absent"}, {"fps", 30}};
+  const fs::path live_scene = live.Write();
   const BadCall calls[] = {
+      {"estimate " + live_scene.string(), "/dev/video-daylit-absent: cannot open (No such file or directory); is the camera plugged in?"},
       {"info /no/such/recording", "/no/such/recording: no such file or folder"},
       {"info " + dir + "/broken.json", "broken.json: invalid JSON"},
       {"info " + nan_scene.string(), "nan.obj:3: vertex coordinate y is not a finite number ('nan')"},

@@ -1,3 +1,6 @@
+#include <atomic>
+#include <csignal>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -13,6 +16,9 @@
 namespace daylit::app {
 namespace {
 
+std::atomic<bool> g_stop_estimate{false};
+extern "C" void StopEstimate(int) { g_stop_estimate = true; }
+
 struct EstimateCommandOptions {
   std::string recording;
   std::string cache;
@@ -23,11 +29,19 @@ struct EstimateCommandOptions {
 
 void RunEstimateCommand(const EstimateCommandOptions& o) {
   const scene::Scene scene = scene::LoadScene(o.recording);
+  // The frames first: a camera that is not there is an error now, not after the bake.
+  std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
   const std::filesystem::path dir = bake::CacheDir(scene, o.cache);
   bool loaded = false;
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, dir, &loaded);
   Log().info("{} the bake: {}", loaded ? "loaded" : "made", dir.string());
-  const estimation::EstimateRun run = estimation::EstimateRecording(scene, baked, o.estimate);
+  // Ctrl-C ends a live run after the frame at hand; the CSV and plot are still written.
+  estimation::EstimateOptions options = o.estimate;
+  g_stop_estimate = false;
+  options.stop = &g_stop_estimate;
+  std::signal(SIGINT, StopEstimate);
+  const estimation::EstimateRun run = estimation::EstimateRecording(scene, baked, options, std::move(source));
+  std::signal(SIGINT, SIG_DFL);
   WriteFileAtomically(o.out, estimation::EstimatesCsv(run.frames));
   const size_t n = run.frames.size();
   double moves_ms = 0.0;
@@ -64,6 +78,8 @@ void AddEstimateCommand(CLI::App& app) {
   cmd->add_option("--plot", options->plot, "Plot PNG (default: the CSV's name with .png)");
   cmd->add_option("--samples", options->estimate.sampler.samples, "Samples per frame (default 8000)")
       ->check(CLI::Range(100, 1000000));
+  cmd->add_option("--frames", options->estimate.max_frames, "Stop after this many frames (a live camera runs until Ctrl-C)")
+      ->check(CLI::PositiveNumber);
   cmd->callback([options] { RunEstimateCommand(*options); });
 }
 
