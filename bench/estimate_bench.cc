@@ -42,23 +42,6 @@ struct Courtyard {
   glm::vec3 Capture() const { return glm::vec3(scene.envmap->position); }
 };
 
-void BM_DecodeFrame(benchmark::State& state) {
-  const Courtyard& c = Courtyard::Get();
-  auto decoder = std::make_unique<capture::VideoDecoder>(c.scene.frames.video);
-  cv::Mat rgb;
-  for (auto _ : state) {
-    if (!decoder->Next(&rgb)) {
-      state.PauseTiming();
-      decoder = std::make_unique<capture::VideoDecoder>(c.scene.frames.video);
-      state.ResumeTiming();
-      decoder->Next(&rgb);
-    }
-    benchmark::DoNotOptimize(rgb.data);
-  }
-  state.SetItemsProcessed(state.iterations());
-}
-BENCHMARK(BM_DecodeFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
-
 void BM_LinearizeFrame(benchmark::State& state) {
   const Courtyard& c = Courtyard::Get();
   cv::Mat linear(c.encoded.size(), CV_32FC3);
