@@ -1,0 +1,92 @@
+#include "render/object_mesh.h"
+
+#include <cmath>
+
+#include <glm/gtc/constants.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "base/error.h"
+#include "scene/model.h"
+
+namespace daylit::render {
+
+Mesh SphereMesh(float radius, int stacks, int slices) {
+  Mesh mesh;
+  for (int i = 0; i <= stacks; ++i) {
+    const float theta = glm::pi<float>() * static_cast<float>(i) / static_cast<float>(stacks);
+    for (int j = 0; j <= slices; ++j) {
+      const float phi = 2.0f * glm::pi<float>() * static_cast<float>(j) / static_cast<float>(slices);
+      const glm::vec3 n(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+      mesh.positions.push_back(radius * n);
+      mesh.normals.push_back(n);
+    }
+  }
+  const auto at = [&](int i, int j) { return static_cast<uint32_t>(i * (slices + 1) + j); };
+  for (int i = 0; i < stacks; ++i) {
+    for (int j = 0; j < slices; ++j) {
+      // Counter-clockwise from outside: θ grows downward from +Z, φ grows counter-clockwise.
+      if (i > 0) mesh.indices.insert(mesh.indices.end(), {at(i, j), at(i + 1, j), at(i, j + 1)});
+      if (i < stacks - 1) mesh.indices.insert(mesh.indices.end(), {at(i, j + 1), at(i + 1, j), at(i + 1, j + 1)});
+    }
+  }
+  return mesh;
+}
+
+Mesh BoxMesh(const glm::vec3& size) {
+  Mesh mesh;
+  const glm::vec3 h = 0.5f * size;
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const float sign : {-1.0f, 1.0f}) {
+      glm::vec3 n(0.0f);
+      n[axis] = sign;
+      const glm::vec3 u = axis == 2 ? glm::vec3(1, 0, 0) : glm::vec3(0, 0, 1);
+      const glm::vec3 v = glm::cross(n, u);  // (u, v, n) right-handed: counter-clockwise from outside
+      const auto base = static_cast<uint32_t>(mesh.positions.size());
+      for (const auto& [a, b] : {std::pair{-1.0f, -1.0f}, std::pair{1.0f, -1.0f}, std::pair{1.0f, 1.0f}, std::pair{-1.0f, 1.0f}}) {
+        mesh.positions.push_back(h * (n + a * u + b * v));
+        mesh.normals.push_back(n);
+      }
+      mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    }
+  }
+  return mesh;
+}
+
+Mesh ObjectMesh(const scene::VirtualObject& object) {
+  Mesh mesh;
+  switch (object.kind) {
+    case scene::MeshKind::kSphere: mesh = SphereMesh(static_cast<float>(object.radius), 48, 96); break;
+    case scene::MeshKind::kBox: mesh = BoxMesh(glm::vec3(object.size)); break;
+    case scene::MeshKind::kFile: {
+      const std::string ext = object.file.extension().string();
+      if (ext != ".obj") ThrowInputError("{}: only OBJ meshes are read so far", object.file.string());
+      const scene::SceneModel model = scene::LoadObjModel(object.file);
+      if (model.triangles.empty()) ThrowInputError("{}: no triangles", object.file.string());
+      for (const scene::Triangle& t : model.triangles) {
+        const glm::vec3 a = model.vertices[t.v[0]], b = model.vertices[t.v[1]], c = model.vertices[t.v[2]];
+        const glm::vec3 cross = glm::cross(b - a, c - a);
+        const glm::vec3 n = glm::length(cross) > 0.0f ? glm::normalize(cross) : glm::vec3(0, 0, 1);
+        for (const glm::vec3& p : {a, b, c}) {
+          mesh.indices.push_back(static_cast<uint32_t>(mesh.positions.size()));
+          mesh.positions.push_back(p);
+          mesh.normals.push_back(n);
+        }
+      }
+      break;
+    }
+  }
+  const glm::dvec3 r = glm::radians(object.rotation_deg);
+  glm::dmat4 m = glm::translate(glm::dmat4(1.0), object.position);
+  m = glm::rotate(m, r.z, glm::dvec3(0, 0, 1));
+  m = glm::rotate(m, r.y, glm::dvec3(0, 1, 0));
+  m = glm::rotate(m, r.x, glm::dvec3(1, 0, 0));
+  m = glm::scale(m, object.scale);
+  const glm::mat3 normal_matrix = glm::mat3(glm::transpose(glm::inverse(glm::dmat3(m))));
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    mesh.positions[i] = glm::vec3(m * glm::dvec4(glm::dvec3(mesh.positions[i]), 1.0));
+    mesh.normals[i] = glm::normalize(normal_matrix * mesh.normals[i]);
+  }
+  return mesh;
+}
+
+}  // namespace daylit::render

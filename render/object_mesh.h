@@ -1,0 +1,31 @@
+// Triangle meshes of the virtual objects in scene coordinates: scene.json's builtin sphere and
+// box, or an OBJ file, placed by the object's scale, rotation and position. CPU only; the
+// renderer uploads them.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "scene/scene.h"
+
+namespace daylit::render {
+
+struct Mesh {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;  // unit, per vertex
+  std::vector<uint32_t> indices;   // triangles, counter-clockwise seen from outside
+};
+
+// A UV sphere of `stacks` × `slices` quads about the origin, normals exact.
+Mesh SphereMesh(float radius, int stacks, int slices);
+// A box of full edge lengths `size` about the origin, flat normals.
+Mesh BoxMesh(const glm::vec3& size);
+
+// The object's mesh placed in the scene: R = Rz·Ry·Rx from rotation_deg, then scale, then the
+// position. OBJ files get per-face normals. Throws InputError naming the file for a mesh that
+// cannot be read or has no triangles.
+Mesh ObjectMesh(const scene::VirtualObject& object);
+
+}  // namespace daylit::render
