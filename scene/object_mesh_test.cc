@@ -1,12 +1,11 @@
-#include "render/object_mesh.h"
+#include "scene/object_mesh.h"
 
 #include <gtest/gtest.h>
 
 #include <glm/gtc/constants.hpp>
 
-#include "render/projection.h"
 
-namespace daylit::render {
+namespace daylit::scene {
 namespace {
 
 // Volume by the divergence theorem: Σ over triangles of (a · (b × c)) / 6; positive when every
@@ -31,8 +30,8 @@ TEST(ObjectMeshTest, BuiltinShapesAreClosedOutwardAndTheRightSize) {
 }
 
 TEST(ObjectMeshTest, PlacementRotatesThenMoves) {
-  scene::VirtualObject box;
-  box.kind = scene::MeshKind::kBox;
+  VirtualObject box;
+  box.kind = MeshKind::kBox;
   box.size = glm::dvec3(2.0, 1.0, 1.0);
   box.position = glm::dvec3(1.0, 2.0, 3.0);
   box.rotation_deg = glm::dvec3(0.0, 0.0, 90.0);  // the long side turns from x to y
@@ -45,20 +44,5 @@ TEST(ObjectMeshTest, PlacementRotatesThenMoves) {
   EXPECT_NEAR(Volume(m), 2.0, 1e-5);  // still outward
 }
 
-TEST(ProjectionTest, GlMatricesLandOnOpenCvsPixels) {
-  const scene::Scene scene = scene::LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a");
-  const scene::CameraModel camera = scene.Camera();
-  const glm::mat4 clip = ClipFromCamera(scene.intrinsics, 0.05f, 500.0f) * CameraFromWorld(scene.cam_from_world);
-  for (const glm::dvec3& p : {glm::dvec3(-0.8, -2.2, 0.5), glm::dvec3(1.6, -0.6, 0.5), glm::dvec3(0.0, 0.0, 0.0)}) {
-    const glm::dvec2 uv = camera.Project(p);
-    const glm::vec4 c = clip * glm::vec4(glm::vec3(p), 1.0f);
-    const double wx = (c.x / c.w + 1.0) * 0.5 * scene.intrinsics.width, wy = (c.y / c.w + 1.0) * 0.5 * scene.intrinsics.height;
-    EXPECT_NEAR(wx, uv.x + 0.5, 1e-2);
-    EXPECT_NEAR(wy, scene.intrinsics.height - (uv.y + 0.5), 1e-2);
-    EXPECT_GT(c.z / c.w, -1.0f);
-    EXPECT_LT(c.z / c.w, 1.0f);
-  }
-}
-
 }  // namespace
-}  // namespace daylit::render
+}  // namespace daylit::scene

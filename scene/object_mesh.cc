@@ -1,4 +1,4 @@
-#include "render/object_mesh.h"
+#include "scene/object_mesh.h"
 
 #include <cmath>
 
@@ -8,7 +8,7 @@
 #include "base/error.h"
 #include "scene/model.h"
 
-namespace daylit::render {
+namespace daylit::scene {
 
 Mesh SphereMesh(float radius, int stacks, int slices) {
   Mesh mesh;
@@ -52,17 +52,17 @@ Mesh BoxMesh(const glm::vec3& size) {
   return mesh;
 }
 
-Mesh ObjectMesh(const scene::VirtualObject& object) {
+Mesh ObjectMesh(const VirtualObject& object) {
   Mesh mesh;
   switch (object.kind) {
-    case scene::MeshKind::kSphere: mesh = SphereMesh(static_cast<float>(object.radius), 48, 96); break;
-    case scene::MeshKind::kBox: mesh = BoxMesh(glm::vec3(object.size)); break;
-    case scene::MeshKind::kFile: {
+    case MeshKind::kSphere: mesh = SphereMesh(static_cast<float>(object.radius), 48, 96); break;
+    case MeshKind::kBox: mesh = BoxMesh(glm::vec3(object.size)); break;
+    case MeshKind::kFile: {
       const std::string ext = object.file.extension().string();
       if (ext != ".obj") ThrowInputError("{}: only OBJ meshes are read so far", object.file.string());
-      const scene::SceneModel model = scene::LoadObjModel(object.file);
+      const SceneModel model = LoadObjModel(object.file);
       if (model.triangles.empty()) ThrowInputError("{}: no triangles", object.file.string());
-      for (const scene::Triangle& t : model.triangles) {
+      for (const Triangle& t : model.triangles) {
         const glm::vec3 a = model.vertices[t.v[0]], b = model.vertices[t.v[1]], c = model.vertices[t.v[2]];
         const glm::vec3 cross = glm::cross(b - a, c - a);
         const glm::vec3 n = glm::length(cross) > 0.0f ? glm::normalize(cross) : glm::vec3(0, 0, 1);
@@ -89,4 +89,20 @@ Mesh ObjectMesh(const scene::VirtualObject& object) {
   return mesh;
 }
 
-}  // namespace daylit::render
+SceneModel ObjectsModel(const std::vector<VirtualObject>& objects) {
+  SceneModel model;
+  for (size_t o = 0; o < objects.size(); ++o) {
+    const Mesh mesh = ObjectMesh(objects[o]);
+    const auto base = static_cast<uint32_t>(model.vertices.size());
+    model.vertices.insert(model.vertices.end(), mesh.positions.begin(), mesh.positions.end());
+    for (size_t t = 0; t < mesh.indices.size(); t += 3) {
+      model.triangles.push_back({{base + mesh.indices[t], base + mesh.indices[t + 1], base + mesh.indices[t + 2]},
+                                 static_cast<uint32_t>(o)});
+    }
+    model.surface_names.push_back("object_" + std::to_string(o));
+  }
+  model.file = "objects";
+  return model;
+}
+
+}  // namespace daylit::scene

@@ -1,6 +1,6 @@
 // Triangle meshes of the virtual objects in scene coordinates: scene.json's builtin sphere and
-// box, or an OBJ file, placed by the object's scale, rotation and position. CPU only; the
-// renderer uploads them.
+// box, or an OBJ file, placed by the object's scale, rotation and position. The renderer draws
+// them; the ray caster casts the shadows and sky occlusion they add to the real scene.
 #pragma once
 
 #include <cstdint>
@@ -8,9 +8,10 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/model.h"
 #include "scene/scene.h"
 
-namespace daylit::render {
+namespace daylit::scene {
 
 struct Mesh {
   std::vector<glm::vec3> positions;
@@ -26,6 +27,9 @@ Mesh BoxMesh(const glm::vec3& size);
 // The object's mesh placed in the scene: R = Rz·Ry·Rx from rotation_deg, then scale, then the
 // position. OBJ files get per-face normals. Throws InputError naming the file for a mesh that
 // cannot be read or has no triangles.
-Mesh ObjectMesh(const scene::VirtualObject& object);
+Mesh ObjectMesh(const VirtualObject& object);
 
-}  // namespace daylit::render
+// All the objects as one triangle model, surface i being object i (for a RayCaster).
+SceneModel ObjectsModel(const std::vector<VirtualObject>& objects);
+
+}  // namespace daylit::scene
