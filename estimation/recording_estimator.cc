@@ -190,21 +190,26 @@ FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, const 
   if (position >= times.size()) {
     ThrowInputError("{}: frame {} is past the recording's {} frames", scene.file.string(), position, times.size());
   }
-  DecodedFrame decoded;
-  {
-    std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
-    source->Seek(times[position].index);
-    FramePipeline frames(std::move(source));
-    decoded = frames.Next();
+  std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
+  source->Seek(times[position].index);
+  capture::Frame frame;
+  if (source->Next(&frame) != capture::FrameStatus::kFrame) {
+    ThrowInputError("{}: frame {} cannot be decoded", scene.file.string(), times[position].index);
   }
+  return FitDecodedFrame(scene, bake, caster, std::move(frame), options);
+}
+
+FrameFit FitDecodedFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                         capture::Frame frame, const EstimateOptions& options) {
   FrameFit out;
-  out.row.frame = times[position].index;
-  out.row.time_utc = times[position].utc;
-  if (!decoded.ok || decoded.rgb.cols != bake.camera.width || decoded.rgb.rows != bake.camera.height) {
-    ThrowInputError("{}: frame {} cannot be decoded", scene.file.string(), out.row.frame);
+  out.row.frame = frame.index;
+  out.row.time_utc = frame.utc;
+  if (frame.rgb.cols != bake.camera.width || frame.rgb.rows != bake.camera.height) {
+    ThrowInputError("{}: frame {} is {}x{}, not the camera's {}x{}", scene.file.string(), frame.index, frame.rgb.cols,
+                    frame.rgb.rows, bake.camera.width, bake.camera.height);
   }
   const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(
-      times[position].utc, scene.location, sunmodel::Atmosphere::Standard(scene.location.elevation_m), {});
+      frame.utc, scene.location, sunmodel::Atmosphere::Standard(scene.location.elevation_m), {});
   out.row.sun_elevation_deg = sun.ApparentElevationDeg();
   out.row.sun_azimuth_deg = sun.azimuth_deg;
   out.sun_dir = glm::vec3(scene.GeoFrame().DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg));
@@ -212,12 +217,12 @@ FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, const 
   Sampler sampler(bake, capture, caster, options.sampler);
   sampler.SetSun(out.sun_dir);
   const capture::Linearizer linearizer(scene.response);
-  const std::vector<Sample> samples = sampler.Draw(decoded.rgb, times[position].exposure.value_or(scene.exposure),
-                                                   decoded.linear ? nullptr : &linearizer);
+  const std::vector<Sample> samples = sampler.Draw(frame.rgb, frame.exposure, frame.linear ? nullptr : &linearizer);
   out.fit = FitSunSky(options.fit, samples);
   out.row.light = out.fit.light;
   out.row.confidence = out.fit.confidence;
   out.row.samples = static_cast<int>(samples.size());
+  out.frame = std::move(frame);
   return out;
 }
 

@@ -60,9 +60,13 @@ struct FrameFit {
   FrameEstimate row;       // light and confidence: the fit's own
   SunSkyFitSummary fit;
   glm::vec3 sun_dir{0.0f};  // unit, scene coordinates
+  capture::Frame frame;     // the frame it was fitted to
 };
 FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster, size_t position,
                   const EstimateOptions& options);
+// The same for a frame already read.
+FrameFit FitDecodedFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                         capture::Frame frame, const EstimateOptions& options);
 
 // The stable CSV: frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,sky_g,
 // sky_b,confidence,samples.

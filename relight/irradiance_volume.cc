@@ -116,6 +116,10 @@ glm::vec3 IrradianceVolume::ProbeIrradiance(int i, int j, int k, const glm::vec3
 }
 
 glm::vec3 IrradianceVolume::Irradiance(const glm::vec3& point, const glm::vec3& normal) const {
+  return glm::max(Integrate(point, EvalSh9(glm::dvec3(normal))), glm::vec3(0.0f));
+}
+
+glm::vec3 IrradianceVolume::Integrate(const glm::vec3& point, const Sh9Basis& y) const {
   const glm::ivec3 n = gather_.resolution;
   // Continuous probe coordinates, clamped into the grid.
   glm::vec3 g;
@@ -126,7 +130,6 @@ glm::vec3 IrradianceVolume::Irradiance(const glm::vec3& point, const glm::vec3& 
   }
   const glm::ivec3 i0 = glm::min(glm::ivec3(g), glm::max(n - 2, glm::ivec3(0)));
   const glm::vec3 f = g - glm::vec3(i0);
-  const Sh9Basis y = EvalSh9(glm::dvec3(normal));
   glm::vec3 e(0.0f);
   for (int corner = 0; corner < 8; ++corner) {
     const glm::ivec3 o((corner & 1) != 0, (corner & 2) != 0, (corner & 4) != 0);
@@ -136,7 +139,7 @@ glm::vec3 IrradianceVolume::Irradiance(const glm::vec3& point, const glm::vec3& 
     if (w == 0.0f) continue;
     e += w * Evaluate((static_cast<size_t>(q.z) * n.y + q.y) * n.x + q.x, y);
   }
-  return glm::max(e, glm::vec3(0.0f));
+  return e;
 }
 
 std::vector<uint8_t> ProbesInsideModel(const bake::GatherTables& gather, const scene::RayCaster& caster) {

@@ -38,6 +38,10 @@ class IrradianceVolume {
 
   // Irradiance at `point` (clamped into the volume) on a surface with unit normal `normal`.
   glm::vec3 Irradiance(const glm::vec3& point, const glm::vec3& normal) const;
+  // Σ_c coefficient_c(point) · weights_c, the coefficients trilinear at `point` (clamped into the
+  // volume): Irradiance() with weights Y_c(n); other weights integrate other lobes, e.g. the
+  // light arriving from a set of directions.
+  glm::vec3 Integrate(const glm::vec3& point, const Sh9Basis& weights) const;
   // The same at probe (i, j, k), no interpolation.
   glm::vec3 ProbeIrradiance(int i, int j, int k, const glm::vec3& normal) const;
 

@@ -5,7 +5,10 @@
 
 #include <tbb/parallel_for.h>
 
+#include <glm/gtc/constants.hpp>
+
 #include "bake/sampling.h"
+#include "scene/latlong.h"
 
 namespace daylit::relight {
 namespace {
@@ -21,9 +24,10 @@ bool RayMeetsSphere(const glm::vec3& origin, const glm::vec3& dir, const glm::ve
 
 }  // namespace
 
-ObjectShadows::ObjectShadows(const scene::Scene& scene, const bake::CameraGBuffer& gbuffer, const scene::RayCaster& real,
+ObjectShadows::ObjectShadows(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& real,
                              const scene::RayCaster& objects, const ObjectShadowOptions& options)
-    : gbuffer_(gbuffer), real_(real), objects_(objects), options_(options) {
+    : gbuffer_(bake.camera), real_(real), objects_(objects), options_(options) {
+  const bake::CameraGBuffer& gbuffer = bake.camera;
   // Bounding spheres from the meshes themselves (surface i of the objects' model is object i).
   const scene::SceneModel& model = objects.model();
   std::vector<glm::vec3> lo(scene.objects.size(), glm::vec3(1e30f)), hi(scene.objects.size(), glm::vec3(-1e30f));
@@ -49,29 +53,42 @@ ObjectShadows::ObjectShadows(const scene::Scene& scene, const bake::CameraGBuffe
     }
   }
   const std::vector<glm::vec3> hemisphere = bake::CosineHemisphere(options_.sky_rays);
-  std::vector<float> lost(near.size(), 0.0f);
+  const glm::vec3 capture = scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f);
+  const int env_w = bake.env.width, env_h = bake.env.height;
+  std::vector<Affected> found(near.size());
+  std::vector<std::vector<uint32_t>> texels(near.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, near.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
       const uint32_t p = near[i];
       const glm::vec3 origin = gbuffer.point[p] + options_.offset_m * gbuffer.normal[p];
       const glm::mat3 frame = bake::HemisphereFrame(gbuffer.normal[p], p);
-      int hidden = 0;
+      Affected& a = found[i];
+      a.pixel = p;
+      int sky = 0;
       for (const glm::vec3& local : hemisphere) {
         const glm::vec3 dir = frame * local;
         bool toward_object = false;
         for (const glm::vec4& s : spheres_) toward_object = toward_object || RayMeetsSphere(origin, dir, s);
-        if (toward_object && objects_.Occluded(origin, dir) && !real_.Occluded(origin, dir)) ++hidden;
+        if (!toward_object) continue;
+        const scene::RayHit object = objects_.Intersect(origin, dir);
+        if (!object.IsHit() || real_.Occluded(origin, dir, 0.0f, object.t)) continue;  // none, or a wall in front
+        // What the object hides: the real point behind it, seen from the capture position, or sky.
+        const scene::RayHit behind = real_.Intersect(origin, dir, object.t);
+        const glm::dvec3 toward = behind.IsHit() ? glm::dvec3(origin + behind.t * dir - capture) : glm::dvec3(dir);
+        texels[i].push_back(static_cast<uint32_t>(scene::LatLongTexel(toward, env_w, env_h)));
+        sky += behind.IsHit() ? 0 : 1;
       }
-      lost[i] = static_cast<float>(hidden) / static_cast<float>(hemisphere.size());
+      a.sky_lost = static_cast<float>(sky) / static_cast<float>(hemisphere.size());
+      a.covers = !texels[i].empty();
     }
   });
+  ray_weight_ = glm::pi<float>() / static_cast<float>(hemisphere.size());
   for (size_t i = 0; i < near.size(); ++i) {
-    if (lost[i] <= 0.0f) continue;
-    Affected a;
-    a.pixel = near[i];
-    a.sky = gbuffer.sky_visibility[near[i]];
-    a.sky_lost = std::min(lost[i], a.sky);
-    affected_.push_back(a);
+    if (!found[i].covers) continue;
+    found[i].first = static_cast<uint32_t>(covered_texels_.size());
+    found[i].count = static_cast<uint32_t>(texels[i].size());
+    covered_texels_.insert(covered_texels_.end(), texels[i].begin(), texels[i].end());
+    affected_.push_back(found[i]);
   }
 }
 
@@ -79,8 +96,17 @@ bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
   const glm::vec3 sun = glm::normalize(sun_dir);
   if (has_sun_ && glm::dot(sun, sun_) > std::cos(glm::radians(0.05f))) return false;
   sun_ = sun, has_sun_ = true;
+  // Directions over the sun's disc (radius 0.2665°), a Fibonacci spiral of equal areas.
+  disc_.clear();
+  const glm::mat3 basis = bake::BasisAround(sun);
+  const float radius = std::tan(glm::radians(0.2665f));
+  for (int k = 0; k < options_.sun_rays; ++k) {
+    const float r = radius * std::sqrt((static_cast<float>(k) + 0.5f) / static_cast<float>(options_.sun_rays));
+    const float phi = 2.39996323f * static_cast<float>(k);
+    disc_.push_back(glm::normalize(sun + r * (std::cos(phi) * basis[0] + std::sin(phi) * basis[1])));
+  }
   // Keep the sky-loss pixels, drop the previous sun's shadow-only ones, then find this sun's.
-  std::erase_if(affected_, [](const Affected& a) { return a.sky_lost <= 0.0f; });
+  std::erase_if(affected_, [](const Affected& a) { return !a.covers; });
   std::vector<uint8_t> listed(gbuffer_.point.size(), 0);
   for (const Affected& a : affected_) listed[a.pixel] = 1;
   std::vector<uint32_t> passing;  // facing the sun, sun ray through an object's sphere
@@ -88,7 +114,7 @@ bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
     if (gbuffer_.surface[p] == bake::kNoSurface || listed[p] || glm::dot(gbuffer_.normal[p], sun) <= 0.0f) continue;
     const glm::vec3 origin = gbuffer_.point[p] + options_.offset_m * gbuffer_.normal[p];
     for (const glm::vec4& s : spheres_) {
-      if (RayMeetsSphere(origin, sun, s)) {
+      if (RayMeetsSphere(origin, sun, glm::vec4(glm::vec3(s), s.w + 0.01f * glm::distance(origin, glm::vec3(s))))) {
         passing.push_back(static_cast<uint32_t>(p));
         break;
       }
@@ -101,48 +127,66 @@ bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
       const glm::vec3 n = gbuffer_.normal[a.pixel];
       const glm::vec3 origin = gbuffer_.point[a.pixel] + options_.offset_m * n;
       a.cos_sun = std::max(0.0f, glm::dot(n, sun));
-      a.sun_real = a.cos_sun > 0.0f && !real_.Occluded(origin, sun) ? 1 : 0;
-      a.sun_with = a.sun_real && !objects_.Occluded(origin, sun) ? 1 : 0;
+      // The sun is a disc: the share of it each point sees gives the penumbrae.
+      int real_visible = 0, both_visible = 0;
+      if (a.cos_sun > 0.0f) {
+        for (const glm::vec3& d : disc_) {
+          if (real_.Occluded(origin, d)) continue;
+          ++real_visible;
+          if (!objects_.Occluded(origin, d)) ++both_visible;
+        }
+      }
+      a.sun_real = static_cast<float>(real_visible) / static_cast<float>(disc_.size());
+      a.sun_with = static_cast<float>(both_visible) / static_cast<float>(disc_.size());
     }
   });
   // Shadow-only pixels the objects do not shade after all are dropped; order by pixel.
-  std::erase_if(affected_, [](const Affected& a) { return a.sky_lost <= 0.0f && a.sun_with == a.sun_real; });
+  std::erase_if(affected_, [](const Affected& a) { return !a.covers && a.sun_with == a.sun_real; });
   std::sort(affected_.begin(), affected_.end(), [](const Affected& a, const Affected& b) { return a.pixel < b.pixel; });
   return true;
 }
 
-namespace {
-
-glm::vec3 RatioOf(const estimation::SunSky& light, float cos_sun, float sky, float sky_lost, bool sun_real, bool sun_with) {
-  glm::vec3 ratio(1.0f);
-  for (int c = 0; c < 3; ++c) {
-    const float e_sun = static_cast<float>(light.sun_rgb[c]) * cos_sun, e_sky = static_cast<float>(light.sky_rgb[c]);
-    const float before = e_sky * sky + (sun_real ? e_sun : 0.0f);
-    const float after = e_sky * (sky - sky_lost) + (sun_with ? e_sun : 0.0f);
-    if (before > 1e-12f) ratio[c] = std::max(0.0f, after) / before;
+void ObjectShadows::Apply(const estimation::SunSky& light, const std::vector<glm::vec3>* env, float* rgb) const {
+  // B, the irradiance each pixel shows, from the frame itself: π·L/ρ, averaged over the pixel's
+  // 5×5 neighbours on the same surface so that the camera's noise is not read as light. The
+  // pixel then keeps the share (B − ΔB)/B of its own value, noise included.
+  const int w = gbuffer_.width, h = gbuffer_.height;
+  std::vector<glm::vec3> keep(affected_.size());
+  for (size_t i = 0; i < affected_.size(); ++i) {
+    const Affected& a = affected_[i];
+    glm::vec3 lost = glm::vec3(light.sun_rgb) * (a.cos_sun * (a.sun_real - a.sun_with));
+    if (a.covers && env != nullptr) {
+      glm::vec3 sum(0.0f);
+      for (uint32_t k = a.first; k < a.first + a.count; ++k) sum += (*env)[covered_texels_[k]];
+      lost += ray_weight_ * sum;
+    } else if (a.covers) {
+      lost += glm::vec3(light.sky_rgb) * a.sky_lost;
+    }
+    const int x = static_cast<int>(a.pixel % static_cast<uint32_t>(w)), y = static_cast<int>(a.pixel / static_cast<uint32_t>(w));
+    glm::vec3 b(0.0f);
+    int n = 0;
+    for (int dy = -2; dy <= 2; ++dy) {
+      for (int dx = -2; dx <= 2; ++dx) {
+        const int u = x + dx, v = y + dy;
+        if (u < 0 || v < 0 || u >= w || v >= h) continue;
+        const size_t q = static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u);
+        if (gbuffer_.surface[q] != gbuffer_.surface[a.pixel]) continue;
+        const float* l = rgb + 3 * q;
+        b += glm::pi<float>() * glm::vec3(l[0], l[1], l[2]) / glm::max(gbuffer_.albedo[q], glm::vec3(1e-3f));
+        ++n;
+      }
+    }
+    b /= static_cast<float>(std::max(n, 1));
+    for (int c = 0; c < 3; ++c) keep[i][c] = b[c] > 0.0f ? std::clamp(1.0f - lost[c] / b[c], 0.0f, 1.0f) : 1.0f;
   }
-  return ratio;
-}
-
-}  // namespace
-
-void ObjectShadows::Apply(const estimation::SunSky& light, float* rgb) const {
-  for (const Affected& a : affected_) {
-    const glm::vec3 r = RatioOf(light, a.cos_sun, a.sky, a.sky_lost, a.sun_real, a.sun_with);
-    float* p = rgb + 3 * static_cast<size_t>(a.pixel);
-    p[0] *= r.x, p[1] *= r.y, p[2] *= r.z;
+  for (size_t i = 0; i < affected_.size(); ++i) {
+    float* p = rgb + 3 * static_cast<size_t>(affected_[i].pixel);
+    for (int c = 0; c < 3; ++c) p[c] *= keep[i][c];
   }
-}
-
-glm::vec3 ObjectShadows::Ratio(const estimation::SunSky& light, size_t pixel) const {
-  const auto it = std::lower_bound(affected_.begin(), affected_.end(), pixel,
-                                   [](const Affected& a, size_t p) { return a.pixel < p; });
-  if (it == affected_.end() || it->pixel != pixel) return glm::vec3(1.0f);
-  return RatioOf(light, it->cos_sun, it->sky, it->sky_lost, it->sun_real, it->sun_with);
 }
 
 size_t ObjectShadows::SkyLossPixels() const {
-  return static_cast<size_t>(std::count_if(affected_.begin(), affected_.end(), [](const Affected& a) { return a.sky_lost > 0.0f; }));
+  return static_cast<size_t>(std::count_if(affected_.begin(), affected_.end(), [](const Affected& a) { return a.covers; }));
 }
 
 size_t ObjectShadows::ShadowPixels() const {

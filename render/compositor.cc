@@ -43,12 +43,18 @@ void main() {})";
 const char* kObjectVertex = R"(#version 330 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
+layout(location = 2) in vec3 sun_loss;
+layout(location = 3) in vec3 sky_loss;
 uniform mat4 clip_from_world;
 out vec3 world_position;
 out vec3 world_normal;
+out vec3 vertex_sun_loss;
+out vec3 vertex_sky_loss;
 void main() {
   world_position = position;
   world_normal = normal;
+  vertex_sun_loss = sun_loss;
+  vertex_sky_loss = sky_loss;
   gl_Position = clip_from_world * vec4(position, 1.0);
 })";
 
@@ -57,9 +63,12 @@ void main() {
 const char* kObjectFragment = R"(#version 330 core
 in vec3 world_position;
 in vec3 world_normal;
+in vec3 vertex_sun_loss;
+in vec3 vertex_sky_loss;
 uniform vec3 albedo;
 uniform vec3 sun_dir;
 uniform vec3 sun_rgb;
+uniform vec3 sky_rgb;
 uniform mat4 shadow_from_world;
 uniform sampler2DShadow shadow_map;
 uniform float shadow_texel;
@@ -99,13 +108,16 @@ void main() {
     e += texture(sh6, u).rgb * 0.315392 * (3.0 * z * z - 1.0);
     e += texture(sh7, u).rgb * 1.092548 * x * z;
     e += texture(sh8, u).rgb * 0.546274 * (x * x - y * y);
+    // The bounce from real ground the objects themselves shade (relight::ObjectBounce).
+    e -= sun_rgb * vertex_sun_loss + sky_rgb * vertex_sky_loss;
   }
   color = vec4(albedo / kPi * max(e, vec3(0.0)), 1.0);
 })";
 
 struct DrawMesh {
   GlVertexArray vao;
-  GlBuffer positions, normals, indices;
+  GlBuffer positions, normals, indices, sun_loss, sky_loss;
+  size_t vertices = 0;
   GLsizei count = 0;
   glm::vec3 albedo{0.5f};
 };
@@ -126,6 +138,18 @@ DrawMesh Upload(const std::vector<glm::vec3>& positions, const std::vector<glm::
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(normals->size() * sizeof(glm::vec3)), normals->data(), GL_STATIC_DRAW);
     glEnableVertexAttribArray(1);
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  }
+  m.vertices = positions.size();
+  if (normals != nullptr) {
+    // Per-vertex irradiance losses, zero until SetObjectLosses.
+    const std::vector<glm::vec3> zero(positions.size(), glm::vec3(0.0f));
+    for (const auto& [buffer, location] : {std::pair{&m.sun_loss, 2u}, std::pair{&m.sky_loss, 3u}}) {
+      *buffer = NewBuffer();
+      glBindBuffer(GL_ARRAY_BUFFER, buffer->get());
+      glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(zero.size() * sizeof(glm::vec3)), zero.data(), GL_DYNAMIC_DRAW);
+      glEnableVertexAttribArray(location);
+      glVertexAttribPointer(location, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+    }
   }
   m.indices = NewBuffer();
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, m.indices.get());
@@ -228,6 +252,21 @@ Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& optio
 
 Compositor::~Compositor() = default;
 
+void Compositor::SetObjectLosses(const std::vector<glm::vec3>& sun_loss, const std::vector<glm::vec3>& sky_loss) {
+  size_t offset = 0;
+  for (const DrawMesh& m : gl_->objects) {
+    if (offset + m.vertices > sun_loss.size() || offset + m.vertices > sky_loss.size()) {
+      ThrowInputError("SetObjectLosses: {} values for {}+ vertices", sun_loss.size(), offset + m.vertices);
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, m.sun_loss.get());
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(m.vertices * sizeof(glm::vec3)), sun_loss.data() + offset);
+    glBindBuffer(GL_ARRAY_BUFFER, m.sky_loss.get());
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(m.vertices * sizeof(glm::vec3)), sky_loss.data() + offset);
+    offset += m.vertices;
+  }
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
 int Compositor::width() const { return gl_->width; }
 int Compositor::height() const { return gl_->height; }
 
@@ -307,6 +346,8 @@ void Compositor::Render(const CompositeInput& input, std::vector<float>* out) {
   glUniform3fv(g.object.Uniform("sun_dir"), 1, glm::value_ptr(sun));
   const glm::vec3 sun_rgb = sun_up ? glm::vec3(input.light.sun_rgb) : glm::vec3(0.0f);
   glUniform3fv(g.object.Uniform("sun_rgb"), 1, glm::value_ptr(sun_rgb));
+  const glm::vec3 sky_rgb(input.light.sky_rgb);
+  glUniform3fv(g.object.Uniform("sky_rgb"), 1, glm::value_ptr(sky_rgb));
   glUniform1f(g.object.Uniform("shadow_texel"), shadow_texel);
   glActiveTexture(GL_TEXTURE1);
   glBindTexture(GL_TEXTURE_2D, g.shadow_map.get());

@@ -42,6 +42,10 @@ class Compositor {
   int width() const;
   int height() const;
 
+  // The irradiance each object vertex loses per unit E_sun and per unit E_sky, all objects in
+  // scene::ObjectMesh order (relight::ObjectBounce); applied with the volume's light.
+  void SetObjectLosses(const std::vector<glm::vec3>& sun_loss, const std::vector<glm::vec3>& sky_loss);
+
   // Renders one frame; `out` receives camera-size linear RGB, row-major from the top row.
   void Render(const CompositeInput& input, std::vector<float>* out);
 

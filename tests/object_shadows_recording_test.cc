@@ -1,6 +1,7 @@
 // The shadows and sky loss the virtual objects bring to the real surfaces, against the path
 // tracer: groundtruth/with_objects ÷ without_objects is the true change per pixel. The light is
-// groundtruth.csv's, so this measures the shadow model alone, not the estimation.
+// groundtruth.csv's and the frame the noise-free one, so this measures the shadow model alone,
+// not the estimation or the camera's noise.
 #include "relight/object_shadows.h"
 
 #include <gtest/gtest.h>
@@ -13,6 +14,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "base/csv.h"
+#include "estimation/recording_estimator.h"
+#include "relight/env_relight.h"
 #include "scene/hdr_image.h"
 #include "scene/object_mesh.h"
 #include "sunmodel/solar_position.h"
@@ -35,7 +38,9 @@ TEST(ObjectShadowsRecordingTest, ShadowsAndSkyLossMatchThePathTracer) {
   const scene::Scene& scene = c.scene;
   const scene::RayCaster real(scene.model);
   const scene::RayCaster objects(scene::ObjectsModel(scene.objects));
-  ObjectShadows shadows(scene, c.bake.camera, real, objects);
+  ObjectShadows shadows(scene, c.bake, real, objects);
+  EnvRelighter relighter(c.bake, glm::vec3(scene.envmap->position), real);
+  std::vector<glm::vec3> env;
   std::printf("sky loss on %zu pixels\n", shadows.SkyLossPixels());
   const CsvTable truth_csv = ReadCsvFile(*scene.groundtruth.lighting);
   std::map<int, estimation::SunSky> truth_light;
@@ -51,20 +56,23 @@ TEST(ObjectShadowsRecordingTest, ShadowsAndSkyLossMatchThePathTracer) {
   const sunmodel::Atmosphere atmosphere = sunmodel::Atmosphere::Standard(scene.location.elevation_m);
   double worst = 0.0;
   int frames = 0;
-  for (const auto& [index, time] : [&] {
-         std::vector<std::pair<int, UtcTime>> v;
-         for (const auto& f : scene.frame_times->frames) v.emplace_back(f.index, f.utc);
-         return v;
-       }()) {
+  for (size_t position = 0; position < scene.frame_times->frames.size(); ++position) {
+    const int index = scene.frame_times->frames[position].index;
+    const UtcTime time = scene.frame_times->frames[position].utc;
     const fs::path with_file = gt / "with_objects" / fmt::format("{:06d}.exr", index);
     if (!fs::is_regular_file(with_file)) continue;
+    // The truth's E_sun and E_sky; the clouds' share (not in groundtruth.csv) from the fit.
+    const double overcast = estimation::FitFrame(scene, c.bake, real, position, {}).fit.overcast_share;
     const scene::HdrImage with = scene::ReadHdrImage(with_file);
     scene::HdrImage predicted = scene::ReadHdrImage(gt / "without_objects" / fmt::format("{:06d}.exr", index));
     const scene::HdrImage without = predicted;
     const cv::Mat mask = cv::imread((gt / "objects_mask" / fmt::format("{:06d}.png", index)).string(), cv::IMREAD_GRAYSCALE);
     const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(time, scene.location, atmosphere, {});
-    shadows.SetSun(glm::vec3(scene.GeoFrame().DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg)));
-    shadows.Apply(truth_light.at(index), predicted.rgb.data());
+    const glm::vec3 sun_dir(scene.GeoFrame().DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg));
+    shadows.SetSun(sun_dir);
+    relighter.SetSun(sun_dir);
+    relighter.Relight(truth_light.at(index), overcast, &env);
+    shadows.Apply(truth_light.at(index), &env, predicted.rgb.data());
     ShadowFidelity f;
     size_t changed = 0;
     for (size_t p = 0; p < with.rgb.size() / 3; ++p) {
@@ -92,7 +100,7 @@ TEST(ObjectShadowsRecordingTest, ShadowsAndSkyLossMatchThePathTracer) {
     ++frames;
   }
   EXPECT_EQ(frames, 12);
-  EXPECT_LT(worst, 0.10);
+  EXPECT_LT(worst, 0.09);  // measured 2.7-7.1% per frame
 }
 
 }  // namespace

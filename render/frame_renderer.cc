@@ -1,0 +1,55 @@
+#include "render/frame_renderer.h"
+
+#include "base/error.h"
+#include "scene/object_mesh.h"
+
+namespace daylit::render {
+
+FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                             const CompositorOptions& options)
+    : scene_(scene),
+      caster_(caster),
+      objects_(scene::ObjectsModel(scene.objects)),
+      shadows_(scene, bake, caster, objects_),
+      bounce_(scene, bake, caster, objects_),
+      relighter_(bake, scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f), caster),
+      compositor_(scene, options),
+      linearizer_(scene.response) {
+  if (!bake.gather.directions.empty()) {
+    volume_ = std::make_unique<relight::IrradianceVolume>(bake.gather, relight::ProbesInsideModel(bake.gather, caster));
+  }
+}
+
+void FrameRenderer::Render(const capture::Frame& frame, const estimation::SunSky& light, double overcast_share,
+                           const glm::vec3& sun_dir, std::vector<float>* out) {
+  if (frame.rgb.cols != width() || frame.rgb.rows != height() || frame.rgb.type() != CV_32FC3) {
+    ThrowInputError("frame {}: {}x{}, not the camera's {}x{}", frame.index, frame.rgb.cols, frame.rgb.rows, width(), height());
+  }
+  // Linear radiance: the response's inverse, then the exposure divided out.
+  const size_t n = static_cast<size_t>(width()) * height() * 3;
+  linear_.resize(n);
+  const float scale = static_cast<float>(1.0 / frame.exposure);
+  const float* in = frame.rgb.ptr<float>();
+  if (frame.linear) {
+    for (size_t i = 0; i < n; ++i) linear_[i] = in[i] * scale;
+  } else {
+    for (size_t i = 0; i < n; ++i) linear_[i] = linearizer_(in[i], static_cast<int>(i % 3)) * scale;
+  }
+  CompositeInput input;
+  input.light = light;
+  input.sun_dir = sun_dir;
+  if (volume_) {
+    if (bounce_.SetSun(sun_dir)) compositor_.SetObjectLosses(bounce_.sun_loss(), bounce_.sky_loss());
+    relighter_.SetSun(sun_dir);
+    relighter_.Relight(light, overcast_share, &env_);
+    volume_->Update(env_);
+    input.volume = &volume_->coefficients();
+  }
+  background_ = linear_;
+  shadows_.SetSun(sun_dir);
+  shadows_.Apply(light, volume_ ? &env_ : nullptr, background_.data());
+  input.background = background_.data();
+  compositor_.Render(input, out);
+}
+
+}  // namespace daylit::render

@@ -1,0 +1,54 @@
+// One frame of the augmented video, from a fitted frame (estimation::FitFrame or the replay's
+// estimate) to the composite in linear radiance units: the frame linearised with the camera
+// response and its exposure divided out, the objects' shadows and sky loss applied to the real
+// surfaces (relight::ObjectShadows), the environment map relit with the estimate and the
+// irradiance volume updated from it, then the objects drawn (Compositor). Needs a current GL
+// context; everything sun-dependent is recomputed only when the sun has moved.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "bake/bake.h"
+#include "estimation/recording_estimator.h"
+#include "render/compositor.h"
+#include "relight/env_relight.h"
+#include "relight/irradiance_volume.h"
+#include "relight/object_bounce.h"
+#include "relight/object_shadows.h"
+#include "scene/raycaster.h"
+#include "scene/scene.h"
+
+namespace daylit::render {
+
+class FrameRenderer {
+ public:
+  // `caster` is over the scene's model; the renderer keeps references to all three.
+  FrameRenderer(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                const CompositorOptions& options = {});
+
+  // The composite of `frame` under `light` (the estimate, filtered or not) and the sun `sun_dir`.
+  void Render(const capture::Frame& frame, const estimation::SunSky& light, double overcast_share,
+              const glm::vec3& sun_dir, std::vector<float>* out);
+
+  // The frame linearised in radiance units, before the objects and their shadows.
+  const std::vector<float>& linear_frame() const { return linear_; }
+  const relight::ObjectShadows& shadows() const { return shadows_; }
+  int width() const { return compositor_.width(); }
+  int height() const { return compositor_.height(); }
+
+ private:
+  const scene::Scene& scene_;
+  const scene::RayCaster& caster_;
+  scene::RayCaster objects_;
+  relight::ObjectShadows shadows_;
+  relight::ObjectBounce bounce_;
+  relight::EnvRelighter relighter_;
+  std::unique_ptr<relight::IrradianceVolume> volume_;
+  Compositor compositor_;
+  capture::Linearizer linearizer_;
+  std::vector<float> linear_, background_;
+  std::vector<glm::vec3> env_;
+};
+
+}  // namespace daylit::render
