@@ -69,7 +69,8 @@ TEST(CompositorTest, ObjectsAppearWhereTheCameraProjectsThemLitByTheSunAndNothin
   Fixture f;
   const std::vector<float> image = f.Render(f.scene.objects);
   const scene::CameraModel camera = f.scene.Camera();
-  const scene::RayCaster real(f.scene.model), objects(scene::ObjectsModel(f.scene.objects));
+  const scene::SceneModel objects_model = scene::ObjectsModel(f.scene.objects);
+  const scene::RayCaster real(f.scene.model), objects(objects_model);
   // The sphere's point halfway between the camera's and the sun's direction: seen and lit.
   const scene::VirtualObject& sphere = f.scene.objects[0];
   ASSERT_EQ(sphere.kind, scene::MeshKind::kSphere);

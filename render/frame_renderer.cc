@@ -9,7 +9,8 @@ FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& b
                              const CompositorOptions& options)
     : scene_(scene),
       caster_(caster),
-      objects_(scene::ObjectsModel(scene.objects)),
+      objects_model_(scene::ObjectsModel(scene.objects)),
+      objects_(objects_model_),
       shadows_(scene, bake, caster, objects_),
       bounce_(scene, bake, caster, objects_),
       relighter_(bake, scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f), caster),

@@ -40,6 +40,7 @@ class FrameRenderer {
  private:
   const scene::Scene& scene_;
   const scene::RayCaster& caster_;
+  scene::SceneModel objects_model_;  // before objects_, which keeps a reference to it
   scene::RayCaster objects_;
   relight::ObjectShadows shadows_;
   relight::ObjectBounce bounce_;

@@ -26,6 +26,9 @@ class RayCaster {
  public:
   // Builds the BVH. Degenerate triangles (zero area or non-finite) are left out and counted.
   explicit RayCaster(const SceneModel& model);
+  // The caster keeps a reference to the model (Embree reads its vertices in place): a temporary
+  // would dangle.
+  explicit RayCaster(SceneModel&& model) = delete;
   ~RayCaster();
   RayCaster(const RayCaster&) = delete;
   RayCaster& operator=(const RayCaster&) = delete;

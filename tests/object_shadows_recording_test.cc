@@ -37,7 +37,8 @@ TEST(ObjectShadowsRecordingTest, ShadowsAndSkyLossMatchThePathTracer) {
   const testing::BundledCourtyard& c = testing::Courtyard();
   const scene::Scene& scene = c.scene;
   const scene::RayCaster real(scene.model);
-  const scene::RayCaster objects(scene::ObjectsModel(scene.objects));
+  const scene::SceneModel objects_model = scene::ObjectsModel(scene.objects);
+  const scene::RayCaster objects(objects_model);
   ObjectShadows shadows(scene, c.bake, real, objects);
   EnvRelighter relighter(c.bake, glm::vec3(scene.envmap->position), real);
   std::vector<glm::vec3> env;

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "render/composite_truth.h"
 #include "render/gl_context.h"
 #include "scene/hdr_image.h"
 #include "tests/courtyard_fixture.h"
@@ -42,29 +43,10 @@ TEST(RenderRecordingTest, CompositesMatchThePathTracedFramesWithObjects) {
     const scene::HdrImage with = scene::ReadHdrImage(with_file);
     const scene::HdrImage without = scene::ReadHdrImage(gt / "without_objects" / fmt::format("{:06d}.exr", index));
     const cv::Mat mask = cv::imread((gt / "objects_mask" / fmt::format("{:06d}.png", index)).string(), cv::IMREAD_GRAYSCALE);
-    double object_error = 0.0, shadow_error = 0.0, floor_error = 0.0;
-    size_t object_pixels = 0, shadow_pixels = 0;
-    for (size_t p = 0; p < with.rgb.size() / 3; ++p) {
-      double error = 0.0, change = 0.0;
-      for (int k = 0; k < 3; ++k) {
-        const double t = with.rgb[3 * p + k];
-        error += std::abs(out[3 * p + k] - t) / std::max(t, 1e-6) / 3.0;
-        change = std::max(change, std::abs(t / std::max<double>(without.rgb[3 * p + k], 1e-6) - 1.0));
-      }
-      if (mask.data[p] >= 128) {
-        object_error += error, ++object_pixels;
-      } else if (mask.data[p] == 0 && change > 0.02) {
-        shadow_error += error, ++shadow_pixels;
-        for (int k = 0; k < 3; ++k) {
-          const double w = without.rgb[3 * p + k];
-          floor_error += std::abs(renderer.linear_frame()[3 * p + k] - w) / std::max(w, 1e-6) / 3.0;
-        }
-      }
-    }
-    object_error /= static_cast<double>(std::max<size_t>(object_pixels, 1));
-    shadow_error /= static_cast<double>(std::max<size_t>(shadow_pixels, 1));
+    const CompositeFidelity f = CompareComposite(out, renderer.linear_frame(), with.rgb, without.rgb, mask);
+    const double object_error = f.object_error, shadow_error = f.shadow_error;
     std::printf("frame %3d: objects %.1f%% over %zu pixels, their shadows %.1f%% over %zu pixels (the video itself %.1f%% off the noise-free frame there)\n", index,
-                100 * object_error, object_pixels, 100 * shadow_error, shadow_pixels, 100 * floor_error / static_cast<double>(std::max<size_t>(shadow_pixels, 1)));
+                100 * object_error, f.object_pixels, 100 * shadow_error, f.shadow_pixels, 100 * f.frame_shadow_error);
     worst_object = std::max(worst_object, object_error), worst_shadow = std::max(worst_shadow, shadow_error);
     mean_object += object_error, mean_shadow += shadow_error;
     ++frames;

@@ -14,5 +14,6 @@ void AddRelightEnvCommand(CLI::App& app);
 void AddLightsCommand(CLI::App& app);
 void AddCalibrateCommands(CLI::App& app);
 void AddRecordCommand(CLI::App& app);
+void AddRenderCommand(CLI::App& app);
 
 }  // namespace daylit::app

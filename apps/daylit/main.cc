@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   daylit::app::AddLightsCommand(app);
   daylit::app::AddCalibrateCommands(app);
   daylit::app::AddRecordCommand(app);
+  daylit::app::AddRenderCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,115 @@
+// daylit render: one frame with the virtual objects, lit and shadowed like the real scene
+// (docs/render.md). PNG is encoded like the video; EXR is the linear composite in radiance units.
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "apps/daylit/commands.h"
+#include "bake/bake.h"
+#include "base/atomic_file.h"
+#include "base/error.h"
+#include "base/log.h"
+#include "estimation/recording_estimator.h"
+#include "render/composite_truth.h"
+#include "render/frame_renderer.h"
+#include "render/gl_context.h"
+#include "scene/hdr_image.h"
+#include "scene/scene.h"
+
+namespace daylit::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RenderOptions {
+  std::string recording;
+  std::string cache;
+  int frame = 0;
+  std::string out = "frame.png";
+};
+
+void WriteLinearExr(const fs::path& path, int width, int height, const std::vector<float>& rgb) {
+  std::vector<float> r(rgb.size() / 3), g(r.size()), b(r.size());
+  for (size_t i = 0; i < r.size(); ++i) r[i] = rgb[3 * i], g[i] = rgb[3 * i + 1], b[i] = rgb[3 * i + 2];
+  scene::WriteExr(path, width, height, {{"R", scene::ExrPixelType::kFloat, r.data()},
+                                        {"G", scene::ExrPixelType::kFloat, g.data()},
+                                        {"B", scene::ExrPixelType::kFloat, b.data()}});
+}
+
+void RunRender(const RenderOptions& o) {
+  const fs::path out(o.out);
+  const std::string ext = out.extension().string();
+  if (ext != ".png" && ext != ".exr") ThrowInputError("--out: {} must end in .png or .exr", o.out);
+  const scene::Scene scene = scene::LoadScene(o.recording);
+  if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
+  const auto& times = scene.frame_times->frames;
+  size_t position = times.size();
+  for (size_t i = 0; i < times.size(); ++i) {
+    if (times[i].index == o.frame) position = i;
+  }
+  if (position == times.size()) ThrowInputError("--frame: {} is not in {}", o.frame, scene.frame_times->file.string());
+  std::string why;
+  const auto gl = render::HeadlessGlContext::Create(&why);
+  if (gl == nullptr) ThrowInputError("OpenGL: {}", why);
+  bool loaded = false;
+  const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, bake::CacheDir(scene, o.cache), &loaded);
+  const scene::RayCaster caster(scene.model);
+  const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, position, {});
+  render::FrameRenderer renderer(scene, baked, caster);
+  std::vector<float> composite;
+  renderer.Render(fit.frame, fit.fit.light, fit.fit.overcast_share, fit.sun_dir, &composite);
+  const int w = renderer.width(), h = renderer.height();
+  if (ext == ".exr") {
+    WriteLinearExr(out, w, h, composite);
+  } else {
+    const cv::Mat bgr = render::EncodeForDisplay(composite, w, h, fit.frame.exposure, scene.response);
+    std::vector<uchar> bytes;
+    if (!cv::imencode(".png", bgr, bytes)) ThrowInputError("{}: cannot encode PNG", o.out);
+    WriteFileAtomically(out, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  }
+  Log().info("frame {}: E_sun ({:.3g}, {:.3g}, {:.3g}), E_sky ({:.3g}, {:.3g}, {:.3g}); wrote {}", o.frame,
+             fit.fit.light.sun_rgb.x, fit.fit.light.sun_rgb.y, fit.fit.light.sun_rgb.z, fit.fit.light.sky_rgb.x,
+             fit.fit.light.sky_rgb.y, fit.fit.light.sky_rgb.z, o.out);
+  // Against the path tracer's frame with the objects, when the recording has it.
+  if (!scene.groundtruth.composites) return;
+  const fs::path gt = *scene.groundtruth.composites;
+  const fs::path with_file = gt / "with_objects" / fmt::format("{:06d}.exr", o.frame);
+  const fs::path without_file = gt / "without_objects" / fmt::format("{:06d}.exr", o.frame);
+  const fs::path mask_file = gt / "objects_mask" / fmt::format("{:06d}.png", o.frame);
+  if (!fs::is_regular_file(with_file) || !fs::is_regular_file(without_file) || !fs::is_regular_file(mask_file)) return;
+  const scene::HdrImage with = scene::ReadHdrImage(with_file), without = scene::ReadHdrImage(without_file);
+  const cv::Mat mask = cv::imread(mask_file.string(), cv::IMREAD_GRAYSCALE);
+  if (with.width != w || with.height != h || without.width != w || without.height != h || mask.cols != w || mask.rows != h) {
+    ThrowInputError("{}: the truth frames are not {}x{}", gt.string(), w, h);
+  }
+  const render::CompositeFidelity f = render::CompareComposite(composite, renderer.linear_frame(), with.rgb, without.rgb, mask);
+  fs::path strip = out;
+  strip.replace_extension();
+  strip += "_vs_truth.png";
+  render::WriteCompositeStrip(strip, w, h, with.rgb, composite, fit.frame.exposure, scene.response);
+  fmt::print("against {}: objects {:.1f}% over {} pixels, their shadows {:.1f}% over {} pixels (the frame itself "
+             "{:.1f}% off the truth there)\n",
+             with_file.string(), 100 * f.object_error, f.object_pixels, 100 * f.shadow_error, f.shadow_pixels,
+             100 * f.frame_shadow_error);
+  Log().info("wrote {} (truth | daylit | difference ×4)", strip.string());
+}
+
+}  // namespace
+
+void AddRenderCommand(CLI::App& app) {
+  auto options = std::make_shared<RenderOptions>();
+  CLI::App* cmd = app.add_subcommand("render", "One frame with the scene's virtual objects, lit and shadowed like it");
+  cmd->footer("Fits the frame's light, relights, and composites the objects with OpenGL (EGL, no display needed).\n"
+              "A .png is encoded like the video; an .exr is the linear composite in radiance units (frame\n"
+              "linearised, exposure divided out). With the recording's ground truth, also compares.");
+  cmd->add_option("recording", options->recording, "Recording folder or its scene.json")->required();
+  cmd->add_option("--frame", options->frame, "Frame number, as in frames.csv")->required();
+  cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
+  cmd->add_option("--out", options->out, "Output .png or .exr (default frame.png)");
+  cmd->callback([options] { RunRender(*options); });
+}
+
+}  // namespace daylit::app

@@ -1,0 +1,41 @@
+// Composites against a path tracer's frame with the objects physically present
+// (groundtruth/with_objects), in the measure: the mean relative error of linear radiance
+// over the objects' pixels (mask ≥ 128) and over the pixels of their shadows (no object, mask 0,
+// where the truth with objects differs from the truth without by more than 2%), averaged over
+// RGB. And a strip for a person to look at: truth | daylit | difference.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "capture/response.h"
+
+namespace daylit::render {
+
+struct CompositeFidelity {
+  double object_error = 0.0;
+  size_t object_pixels = 0;
+  double shadow_error = 0.0;
+  size_t shadow_pixels = 0;
+  double frame_shadow_error = 0.0;  // the frame itself (before compositing) against the truth
+                                    // without objects, on the same pixels: the camera's own share
+};
+
+// All images camera-size, linear RGB row-major from the top; `mask` 8-bit.
+CompositeFidelity CompareComposite(const std::vector<float>& composite, const std::vector<float>& frame,
+                                   const std::vector<float>& truth_with, const std::vector<float>& truth_without,
+                                   const cv::Mat& mask);
+
+// truth | daylit | |difference| × 4, each encoded as the camera would (linear × exposure through
+// the response, 8 bits), written atomically as PNG.
+void WriteCompositeStrip(const std::filesystem::path& png, int width, int height, const std::vector<float>& truth,
+                         const std::vector<float>& composite, double exposure, const capture::CameraResponse& response);
+
+// A linear radiance image encoded like the video's frames: × exposure, the response per channel,
+// 8-bit BGR for OpenCV.
+cv::Mat EncodeForDisplay(const std::vector<float>& linear, int width, int height, double exposure,
+                         const capture::CameraResponse& response);
+
+}  // namespace daylit::render
