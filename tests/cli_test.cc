@@ -57,7 +57,7 @@ const std::string kRecording = DAYLIT_SOURCE_DIR "/recordings/courtyard-a";
 const std::string kProbe = DAYLIT_SOURCE_DIR "/probes/stpeters_latlong_1024x512.hdr";
 
 TEST(CliTest, HelpForEverySubcommand) {
-  for (const char* sub : {"", "sunpos ", "info ", "lights "}) {
+  for (const char* sub : {"", "sunpos ", "info ", "lights ", "record ", "render ", "calibrate-response ", "calibrate-camera "}) {
     const CliRun run = Daylit(std::string(sub) + "--help");
     EXPECT_EQ(run.exit_code, 0) << sub;
     EXPECT_NE(run.out.find("Usage"), std::string::npos) << sub << run.out;
@@ -342,6 +342,35 @@ TEST(CliTest, RecordWritesARecordingThatReplaysItsFrames) {
   }
 }
 
+TEST(CliTest, RenderWritesTheCompositeAndComparesItWithTheTruth) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_render_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string cache = std::string(DAYLIT_BINARY_DIR) + "/test-cache/courtyard-a";
+  const CliRun exr = Daylit("render " + kRecording + " --frame 300 --cache " + cache + " --out " + (dir / "f.exr").string());
+  ASSERT_EQ(exr.exit_code, 0) << exr.err;
+  EXPECT_NE(exr.out.find("objects "), std::string::npos) << exr.out;
+  EXPECT_TRUE(fs::is_regular_file(dir / "f_vs_truth.png"));
+  // The EXR is the linear composite in radiance units: where no object or shadow reaches, the
+  // frame linearised with its exposure divided out, so within the video's noise of the truth.
+  const scene::HdrImage image = scene::ReadHdrImage(dir / "f.exr");
+  const scene::HdrImage truth = scene::ReadHdrImage(kRecording + "/groundtruth/without_objects/000300.exr");
+  ASSERT_EQ(image.width, truth.width);
+  double ratio = 0.0;
+  int n = 0;
+  for (int y = 20; y < 120; ++y) {  // the far wall, above the objects
+    for (int x = 100; x < 860; x += 4) {
+      const size_t p = (static_cast<size_t>(y) * static_cast<size_t>(image.width) + static_cast<size_t>(x)) * 3 + 1;
+      ratio += image.rgb[p] / truth.rgb[p], ++n;
+    }
+  }
+  EXPECT_NEAR(ratio / n, 1.0, 0.03);
+  const CliRun png = Daylit("render " + kRecording + " --frame 300 --cache " + cache + " --out " + (dir / "f.png").string());
+  ASSERT_EQ(png.exit_code, 0) << png.err;
+  const cv::Mat encoded = cv::imread((dir / "f.png").string());
+  EXPECT_EQ(encoded.cols, image.width);
+  fs::remove_all(dir);
+}
+
 TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
   scene::testing::SceneSandbox sandbox("cli");
   sandbox.WriteText("broken.json", "{\"format\": \"daylit-recording/1\",");
@@ -381,6 +410,8 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"record --device /dev/video-daylit-absent --scene " + kRecording + " --out " + dir + "/rec",
        "/dev/video-daylit-absent: cannot open (No such file or directory); is the camera plugged in?"},
       {"record --from " + kRecording + " --out " + dir, "exists; record into a new folder"},
+      {"render " + kRecording + " --frame 300 --out " + dir + "/frame.jpg", "--out: " + dir + "/frame.jpg must end in .png or .exr"},
+      {"render " + kRecording + " --frame 99999 --out " + dir + "/frame.png", "--frame: 99999 is not in"},
   };
   for (const BadCall& call : calls) {
     const CliRun run = Daylit(call.args);  // NOLINT
