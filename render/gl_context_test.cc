@@ -7,20 +7,10 @@
 
 #include <vector>
 
+#include "render/gl_program.h"
+
 namespace daylit::render {
 namespace {
-
-GLuint Compile(GLenum type, const char* source) {
-  const GLuint shader = glCreateShader(type);
-  glShaderSource(shader, 1, &source, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  char log[1024] = {};
-  glGetShaderInfoLog(shader, sizeof(log), nullptr, log);
-  EXPECT_TRUE(ok) << log;
-  return shader;
-}
 
 TEST(GlContextTest, CoreContextRendersExactFloatsIntoAnFbo) {
   std::string why;
@@ -40,25 +30,20 @@ TEST(GlContextTest, CoreContextRendersExactFloatsIntoAnFbo) {
   ASSERT_EQ(glCheckFramebufferStatus(GL_FRAMEBUFFER), static_cast<GLenum>(GL_FRAMEBUFFER_COMPLETE));
 
   // A full-screen triangle from gl_VertexID (core profile still needs a bound VAO).
-  const GLuint program = glCreateProgram();
-  glAttachShader(program, Compile(GL_VERTEX_SHADER, R"(#version 330 core
+  const GlProgram program(R"(#version 330 core
     void main() {
       vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
       gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-    })"));
-  glAttachShader(program, Compile(GL_FRAGMENT_SHADER, R"(#version 330 core
+    })",
+                          R"(#version 330 core
     uniform vec2 size;
     out vec4 color;
-    void main() { color = vec4(gl_FragCoord.xy / size, 37.5, 1.0); })"));
-  glLinkProgram(program);
-  GLint linked = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &linked);
-  ASSERT_TRUE(linked);
+    void main() { color = vec4(gl_FragCoord.xy / size, 37.5, 1.0); })");
   glGenVertexArrays(1, &vao);
   glBindVertexArray(vao);
   glViewport(0, 0, kW, kH);
-  glUseProgram(program);
-  glUniform2f(glGetUniformLocation(program, "size"), static_cast<float>(kW), static_cast<float>(kH));
+  glUseProgram(program.id());
+  glUniform2f(program.Uniform("size"), static_cast<float>(kW), static_cast<float>(kH));
   glDrawArrays(GL_TRIANGLES, 0, 3);
 
   std::vector<float> pixels(kW * kH * 4);
@@ -73,7 +58,6 @@ TEST(GlContextTest, CoreContextRendersExactFloatsIntoAnFbo) {
     }
   }
   glDeleteVertexArrays(1, &vao);
-  glDeleteProgram(program);
   glDeleteFramebuffers(1, &fbo);
   glDeleteTextures(1, &color);
 }

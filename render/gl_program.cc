@@ -46,30 +46,20 @@ GlProgram::GlProgram(const char* vertex_source, const char* fragment_source) {
 
 GlProgram::~GlProgram() { glDeleteProgram(id_); }
 
-GlTexture NewTexture() {
+namespace {
+
+GLuint Generate(void (*gen)(GLsizei, GLuint*)) {
   GLuint id = 0;
-  glGenTextures(1, &id);
-  return GlTexture(id);
+  gen(1, &id);
+  return id;
 }
-GlBuffer NewBuffer() {
-  GLuint id = 0;
-  glGenBuffers(1, &id);
-  return GlBuffer(id);
-}
-GlFramebuffer NewFramebuffer() {
-  GLuint id = 0;
-  glGenFramebuffers(1, &id);
-  return GlFramebuffer(id);
-}
-GlRenderbuffer NewRenderbuffer() {
-  GLuint id = 0;
-  glGenRenderbuffers(1, &id);
-  return GlRenderbuffer(id);
-}
-GlVertexArray NewVertexArray() {
-  GLuint id = 0;
-  glGenVertexArrays(1, &id);
-  return GlVertexArray(id);
-}
+
+}  // namespace
+
+GlTexture NewTexture() { return GlTexture(Generate(glGenTextures)); }
+GlBuffer NewBuffer() { return GlBuffer(Generate(glGenBuffers)); }
+GlFramebuffer NewFramebuffer() { return GlFramebuffer(Generate(glGenFramebuffers)); }
+GlRenderbuffer NewRenderbuffer() { return GlRenderbuffer(Generate(glGenRenderbuffers)); }
+GlVertexArray NewVertexArray() { return GlVertexArray(Generate(glGenVertexArrays)); }
 
 }  // namespace daylit::render
