@@ -410,6 +410,8 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"record --device /dev/video-daylit-absent --scene " + kRecording + " --out " + dir + "/rec",
        "/dev/video-daylit-absent: cannot open (No such file or directory); is the camera plugged in?"},
       {"record --from " + kRecording + " --out " + dir, "exists; record into a new folder"},
+      {"record --device /dev/video-daylit-absent --scene " + kRecording + " --out " + dir + "/rec --exposure-100us -5",
+       "--exposure-100us: Value -5 not in range 1 to 1000000"},
       {"render " + kRecording + " --frame 300 --out " + dir + "/frame.jpg", "--out: " + dir + "/frame.jpg must end in .png or .exr"},
       {"render " + kRecording + " --frame 99999 --out " + dir + "/frame.png", "--frame: 99999 is not in"},
   };

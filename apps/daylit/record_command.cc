@@ -5,6 +5,7 @@
 #include <csignal>
 #include <filesystem>
 #include <memory>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -39,6 +40,7 @@ struct RecordOptions {
   std::optional<int> frames;
   std::optional<double> seconds;
   bool images = false;
+  std::optional<int64_t> exposure_100us, gain, white_balance_k;  // override scene.json's frames.controls
 };
 
 // Copies a file scene.json names into the new folder (keeping its name) and returns the new
@@ -95,6 +97,9 @@ void RunRecord(const RecordOptions& o) {
     v4l2.width = scene.intrinsics.width, v4l2.height = scene.intrinsics.height;
     v4l2.fps = scene.frames.kind == scene::FrameSourceKind::kDevice ? scene.frames.fps : 30.0;
     if (scene.frames.kind == scene::FrameSourceKind::kDevice) v4l2.settings = scene.frames.controls;
+    if (o.exposure_100us) v4l2.settings.exposure_100us = o.exposure_100us;
+    if (o.gain) v4l2.settings.gain = o.gain;
+    if (o.white_balance_k) v4l2.settings.white_balance_k = o.white_balance_k;
     v4l2.exposure = scene.exposure;
     source = capture::OpenV4l2Source(o.device, v4l2);
     fps = v4l2.fps;
@@ -173,6 +178,12 @@ void AddRecordCommand(CLI::App& app) {
   cmd->add_option("--frames", options->frames, "Stop after this many frames");
   cmd->add_option("--seconds", options->seconds, "Stop after this many seconds of frames");
   cmd->add_flag("--images", options->images, "Lossless PNG frames instead of an H.264 video");
+  cmd->add_option("--exposure-100us", options->exposure_100us,
+                  "Exposure in 100 µs units (default: scene.json's frames.controls, else held at what auto reached)")
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--gain", options->gain, "Gain, device units (default as for --exposure-100us)")->check(CLI::Range(0, 1000000));
+  cmd->add_option("--white-balance-k", options->white_balance_k, "White balance in kelvin (default as for --exposure-100us)")
+      ->check(CLI::Range(1000, 20000));
   cmd->callback([options] { RunRecord(*options); });
 }
 
