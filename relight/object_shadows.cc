@@ -39,8 +39,9 @@ ObjectShadows::ObjectShadows(const scene::Scene& scene, const bake::SceneBake& b
     const glm::vec3 centre = 0.5f * (lo[o] + hi[o]);
     spheres_.emplace_back(centre, 0.5f * glm::length(hi[o] - lo[o]) + 1e-3f);
   }
-  // V' once: the pixels near an object cast cosine-weighted rays; a ray that reaches the sky past
-  // the real model but meets an object is sky the object hides.
+  // The covered directions, once: the pixels near an object cast cosine-weighted rays; a ray that
+  // meets an object before the real model carries light the object now blocks (sky, or the real
+  // surface behind it).
   const size_t pixels = gbuffer.point.size();
   std::vector<uint32_t> near;
   for (size_t p = 0; p < pixels; ++p) {

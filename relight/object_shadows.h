@@ -32,7 +32,7 @@ namespace daylit::relight {
 struct ObjectShadowOptions {
   int sky_rays = 256;          // cosine-weighted rays per pixel for V' (as the bake's V)
   float reach_radii = 12.0f;   // pixels farther than this many bounding radii from every object
-                               // lose under 0.7% of their sky to it and are skipped
+                               // lose under 0.7% of their light to it and are skipped
   float offset_m = 2e-3f;      // ray origins off the surface, as in the bake
   int sun_rays = 16;           // over the sun's 0.53° disc, for penumbrae
 };
