@@ -35,11 +35,11 @@ struct CliRun {
   std::string err;
 };
 
-CliRun Daylit(const std::string& args) {
+CliRun Daylit(const std::string& args, const std::string& environment = "") {
   static int counter = 0;
   const fs::path err_file = fs::temp_directory_path() /
                             ("daylit_cli_err_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-  const std::string command = std::string(DAYLIT_BINARY_DIR "/bin/daylit ") + args + " 2>" + err_file.string();
+  const std::string command = environment + std::string(DAYLIT_BINARY_DIR "/bin/daylit ") + args + " 2>" + err_file.string();
   CliRun run;
   FILE* pipe = ::popen(command.c_str(), "r");
   if (pipe == nullptr) return run;
@@ -342,11 +342,16 @@ TEST(CliTest, RecordWritesARecordingThatReplaysItsFrames) {
   }
 }
 
+// Mesa's llvmpipe leaks ~240 bytes that LeakSanitizer sees only after the driver is unloaded
+// (render/CMakeLists.txt): commands that open GL run without leak detection under ASan.
+const std::string kGlEnvironment = "ASAN_OPTIONS=detect_leaks=0 ";
+
 TEST(CliTest, RenderWritesTheCompositeAndComparesItWithTheTruth) {
   const fs::path dir = fs::temp_directory_path() / ("daylit_cli_render_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string cache = std::string(DAYLIT_BINARY_DIR) + "/test-cache/courtyard-a";
-  const CliRun exr = Daylit("render " + kRecording + " --frame 300 --cache " + cache + " --out " + (dir / "f.exr").string());
+  const CliRun exr =
+      Daylit("render " + kRecording + " --frame 300 --cache " + cache + " --out " + (dir / "f.exr").string(), kGlEnvironment);
   ASSERT_EQ(exr.exit_code, 0) << exr.err;
   EXPECT_NE(exr.out.find("objects "), std::string::npos) << exr.out;
   EXPECT_TRUE(fs::is_regular_file(dir / "f_vs_truth.png"));
@@ -364,7 +369,8 @@ TEST(CliTest, RenderWritesTheCompositeAndComparesItWithTheTruth) {
     }
   }
   EXPECT_NEAR(ratio / n, 1.0, 0.03);
-  const CliRun png = Daylit("render " + kRecording + " --frame 300 --cache " + cache + " --out " + (dir / "f.png").string());
+  const CliRun png =
+      Daylit("render " + kRecording + " --frame 300 --cache " + cache + " --out " + (dir / "f.png").string(), kGlEnvironment);
   ASSERT_EQ(png.exit_code, 0) << png.err;
   const cv::Mat encoded = cv::imread((dir / "f.png").string());
   EXPECT_EQ(encoded.cols, image.width);
