@@ -6,29 +6,21 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "base/atomic_file.h"
 #include "base/error.h"
 
 namespace daylit::capture {
 
+namespace {
+
+// The frame's 8-bit BGR: encoded values as they are, linear ones (EXR sources) through `response`.
 cv::Mat EncodeFrame8(const Frame& frame, const CameraResponse& response) {
-  cv::Mat rgb8(frame.rgb.size(), CV_8UC3);
-  for (int y = 0; y < frame.rgb.rows; ++y) {
-    const auto* in = frame.rgb.ptr<cv::Vec3f>(y);
-    auto* out = rgb8.ptr<cv::Vec3b>(y);
-    for (int x = 0; x < frame.rgb.cols; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        const double encoded = frame.linear ? response.ToEncoded(in[x][c], c) : std::clamp(static_cast<double>(in[x][c]), 0.0, 1.0);
-        out[x][c] = static_cast<uint8_t>(std::lround(255.0 * encoded));
-      }
-    }
-  }
-  cv::Mat bgr;
-  cv::cvtColor(rgb8, bgr, cv::COLOR_RGB2BGR);
-  return bgr;
+  const cv::Mat rgb = frame.rgb.isContinuous() ? frame.rgb : frame.rgb.clone();
+  return EncodeToBgr8(rgb.ptr<float>(), rgb.cols, rgb.rows, 1.0, frame.linear ? &response : nullptr);
 }
+
+}  // namespace
 
 RecordingWriter::RecordingWriter(std::filesystem::path dir, bool images, double fps, CameraResponse response)
     : dir_(std::move(dir)), images_(images), fps_(fps), response_(std::move(response)) {

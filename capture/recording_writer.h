@@ -38,7 +38,4 @@ class RecordingWriter {
   int count_ = 0;
 };
 
-// The 8-bit BGR image of a frame: encoded values ×255, rounded; linear ones through `response`.
-cv::Mat EncodeFrame8(const Frame& frame, const CameraResponse& response);
-
 }  // namespace daylit::capture

@@ -91,6 +91,22 @@ std::string CameraResponse::Describe() const {
   return "?";
 }
 
+cv::Mat EncodeToBgr8(const float* rgb, int width, int height, double scale, const CameraResponse* response) {
+  cv::Mat bgr(height, width, CV_8UC3);
+  for (int y = 0; y < height; ++y) {
+    auto* row = bgr.ptr<cv::Vec3b>(y);
+    const float* in = rgb + static_cast<size_t>(y) * static_cast<size_t>(width) * 3;
+    for (int x = 0; x < width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        const double v = in[3 * x + c] * scale;
+        const double encoded = response != nullptr ? response->ToEncoded(v, c) : std::clamp(v, 0.0, 1.0);
+        row[x][2 - c] = static_cast<uint8_t>(std::lround(255.0 * encoded));
+      }
+    }
+  }
+  return bgr;
+}
+
 std::shared_ptr<const ResponseTable> ReadResponseTable(const std::filesystem::path& csv) {
   const CsvTable t = ReadCsvFile(csv);
   const int code = t.RequireColumn("code");

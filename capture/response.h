@@ -63,6 +63,11 @@ class Linearizer {
   std::array<std::array<float, kSteps + 1>, 3> tables_{};
 };
 
+// RGB floats (width·height·3, row-major from the top) as the camera would store them, 8-bit BGR
+// for OpenCV: each value × `scale`, through `response` when it is linear light (the response
+// non-null), else taken as already encoded; clamped to [0, 1], rounded to the nearest code.
+cv::Mat EncodeToBgr8(const float* rgb, int width, int height, double scale, const CameraResponse* response);
+
 // Reads a response table: CSV `code,r,g,b`, 256 rows for codes 0-255, linear values finite,
 // ≥ 0 and non-decreasing (scaled here so that code 255 is 1). Throws InputError naming the
 // file, line and column.

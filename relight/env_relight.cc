@@ -193,15 +193,10 @@ void WriteEnvComparison(const std::filesystem::path& png, const bake::EnvMapMaps
 
 void WriteEnvMap(const std::filesystem::path& exr, int width, int height, const std::vector<glm::vec3>& radiance) {
   const size_t n = static_cast<size_t>(width) * height;
-  std::vector<float> r(n), g(n), b(n), luminance(n);
-  for (size_t i = 0; i < n; ++i) {
-    r[i] = radiance[i].x, g[i] = radiance[i].y, b[i] = radiance[i].z;
-    luminance[i] = Luminance(radiance[i]);
-  }
-  scene::WriteExr(exr, width, height,
-                  {{"R", scene::ExrPixelType::kFloat, r.data(), nullptr},
-                   {"G", scene::ExrPixelType::kFloat, g.data(), nullptr},
-                   {"B", scene::ExrPixelType::kFloat, b.data(), nullptr}});
+  std::vector<float> luminance(n);
+  for (size_t i = 0; i < n; ++i) luminance[i] = Luminance(radiance[i]);
+  static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "glm::vec3 must be three packed floats");
+  scene::WriteRgbExr(exr, width, height, &radiance[0].x);
   std::filesystem::path png = exr;
   report::WritePng(png.replace_extension(".png"), {Preview(width, height, radiance, WhiteOf(luminance))});
 }

@@ -24,12 +24,8 @@ fs::path TempDir() {
 }
 
 fs::path WriteImage(const std::string& name, const scene::HdrImage& image) {
-  std::vector<float> r(image.rgb.size() / 3), g(r.size()), b(r.size());
-  for (size_t i = 0; i < r.size(); ++i) r[i] = image.rgb[3 * i], g[i] = image.rgb[3 * i + 1], b[i] = image.rgb[3 * i + 2];
   const fs::path path = TempDir() / name;
-  scene::WriteExr(path, image.width, image.height, {{"R", scene::ExrPixelType::kFloat, r.data()},
-                                                    {"G", scene::ExrPixelType::kFloat, g.data()},
-                                                    {"B", scene::ExrPixelType::kFloat, b.data()}});
+  scene::WriteRgbExr(path, image.width, image.height, image.rgb.data());
   return path;
 }
 

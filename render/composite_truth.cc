@@ -3,10 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include <opencv2/imgcodecs.hpp>
-
-#include "base/atomic_file.h"
-#include "base/error.h"
+#include "report/plot.h"
 
 namespace daylit::render {
 
@@ -37,34 +34,16 @@ CompositeFidelity CompareComposite(const std::vector<float>& composite, const st
   return f;
 }
 
-cv::Mat EncodeForDisplay(const std::vector<float>& linear, int width, int height, double exposure,
-                         const capture::CameraResponse& response) {
-  cv::Mat bgr(height, width, CV_8UC3);
-  for (int y = 0; y < height; ++y) {
-    auto* row = bgr.ptr<cv::Vec3b>(y);
-    for (int x = 0; x < width; ++x) {
-      const size_t p = static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
-      for (int c = 0; c < 3; ++c) {
-        const double encoded = response.ToEncoded(linear[3 * p + static_cast<size_t>(c)] * exposure, c);
-        row[x][2 - c] = static_cast<uint8_t>(std::lround(255.0 * encoded));
-      }
-    }
-  }
-  return bgr;
-}
-
 void WriteCompositeStrip(const std::filesystem::path& png, int width, int height, const std::vector<float>& truth,
                          const std::vector<float>& composite, double exposure, const capture::CameraResponse& response) {
   std::vector<float> difference(truth.size());
   for (size_t i = 0; i < truth.size(); ++i) difference[i] = 4.0f * std::abs(composite[i] - truth[i]);
   cv::Mat strip;
-  cv::hconcat(std::vector<cv::Mat>{EncodeForDisplay(truth, width, height, exposure, response),
-                                   EncodeForDisplay(composite, width, height, exposure, response),
-                                   EncodeForDisplay(difference, width, height, exposure, response)},
+  cv::hconcat(std::vector<cv::Mat>{capture::EncodeToBgr8(truth.data(), width, height, exposure, &response),
+                                   capture::EncodeToBgr8(composite.data(), width, height, exposure, &response),
+                                   capture::EncodeToBgr8(difference.data(), width, height, exposure, &response)},
               strip);
-  std::vector<uchar> bytes;
-  if (!cv::imencode(".png", strip, bytes)) ThrowInputError("{}: cannot encode PNG", png.string());
-  WriteFileAtomically(png, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  report::WritePng(png, {strip});
 }
 
 }  // namespace daylit::render

@@ -33,9 +33,4 @@ CompositeFidelity CompareComposite(const std::vector<float>& composite, const st
 void WriteCompositeStrip(const std::filesystem::path& png, int width, int height, const std::vector<float>& truth,
                          const std::vector<float>& composite, double exposure, const capture::CameraResponse& response);
 
-// A linear radiance image encoded like the video's frames: × exposure, the response per channel,
-// 8-bit BGR for OpenCV.
-cv::Mat EncodeForDisplay(const std::vector<float>& linear, int width, int height, double exposure,
-                         const capture::CameraResponse& response);
-
 }  // namespace daylit::render

@@ -169,6 +169,15 @@ void WriteExr(const std::filesystem::path& path, int width, int height, const st
   CommitTemporary(tmp, path);
 }
 
+void WriteRgbExr(const std::filesystem::path& path, int width, int height, const float* rgb) {
+  const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
+  std::vector<float> r(n), g(n), b(n);
+  for (size_t i = 0; i < n; ++i) r[i] = rgb[3 * i], g[i] = rgb[3 * i + 1], b[i] = rgb[3 * i + 2];
+  WriteExr(path, width, height, {{"R", ExrPixelType::kFloat, r.data(), nullptr},
+                                 {"G", ExrPixelType::kFloat, g.data(), nullptr},
+                                 {"B", ExrPixelType::kFloat, b.data(), nullptr}});
+}
+
 ExrChannels ReadExrChannels(const std::filesystem::path& path, const std::vector<std::string>& names,
                             const std::vector<std::string>& uint_names) {
   try {

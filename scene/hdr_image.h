@@ -45,6 +45,10 @@ struct ExrChannel {
 // Writes a multi-channel OpenEXR (ZIP compressed) to a temporary file and renames it to `path`.
 void WriteExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels);
 
+// Writes interleaved RGB floats (width·height·3, row-major from the top) as a float R, G, B
+// OpenEXR, through WriteExr.
+void WriteRgbExr(const std::filesystem::path& path, int width, int height, const float* rgb);
+
 // Named channels of an OpenEXR file, read in one pass: float ones (HALF and FLOAT converted by
 // OpenEXR) and UINT ones exactly. Throws InputError naming the file and a missing channel.
 struct ExrChannels {

@@ -9,13 +9,14 @@
 
 #include "apps/daylit/commands.h"
 #include "bake/bake.h"
-#include "base/atomic_file.h"
 #include "base/error.h"
 #include "base/log.h"
+#include "capture/response.h"
 #include "estimation/recording_estimator.h"
 #include "render/composite_truth.h"
 #include "render/frame_renderer.h"
 #include "render/gl_context.h"
+#include "report/plot.h"
 #include "scene/hdr_image.h"
 #include "scene/scene.h"
 
@@ -30,14 +31,6 @@ struct RenderOptions {
   int frame = 0;
   std::string out = "frame.png";
 };
-
-void WriteLinearExr(const fs::path& path, int width, int height, const std::vector<float>& rgb) {
-  std::vector<float> r(rgb.size() / 3), g(r.size()), b(r.size());
-  for (size_t i = 0; i < r.size(); ++i) r[i] = rgb[3 * i], g[i] = rgb[3 * i + 1], b[i] = rgb[3 * i + 2];
-  scene::WriteExr(path, width, height, {{"R", scene::ExrPixelType::kFloat, r.data()},
-                                        {"G", scene::ExrPixelType::kFloat, g.data()},
-                                        {"B", scene::ExrPixelType::kFloat, b.data()}});
-}
 
 void RunRender(const RenderOptions& o) {
   const fs::path out(o.out);
@@ -63,12 +56,9 @@ void RunRender(const RenderOptions& o) {
   renderer.Render(fit.frame, fit.fit.light, fit.fit.overcast_share, fit.sun_dir, &composite);
   const int w = renderer.width(), h = renderer.height();
   if (ext == ".exr") {
-    WriteLinearExr(out, w, h, composite);
+    scene::WriteRgbExr(out, w, h, composite.data());
   } else {
-    const cv::Mat bgr = render::EncodeForDisplay(composite, w, h, fit.frame.exposure, scene.response);
-    std::vector<uchar> bytes;
-    if (!cv::imencode(".png", bgr, bytes)) ThrowInputError("{}: cannot encode PNG", o.out);
-    WriteFileAtomically(out, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+    report::WritePng(out, {capture::EncodeToBgr8(composite.data(), w, h, fit.frame.exposure, &scene.response)});
   }
   Log().info("frame {}: E_sun ({:.3g}, {:.3g}, {:.3g}), E_sky ({:.3g}, {:.3g}, {:.3g}); wrote {}", o.frame,
              fit.fit.light.sun_rgb.x, fit.fit.light.sun_rgb.y, fit.fit.light.sun_rgb.z, fit.fit.light.sky_rgb.x,
