@@ -28,15 +28,10 @@ using Clock = std::chrono::steady_clock;
 
 double Median(std::vector<double> v) { return MedianInPlace(v, static_cast<double>(NAN)); }
 
-// One frame as the estimator reads it: encoded RGB floats (video, PNG, JPEG) or linear ones (EXR).
+// What the source said for one frame (never kWaiting), and the frame.
 struct DecodedFrame {
-  bool ok = false;
-  bool end = false;  // the source has no more frames
-  bool linear = false;
-  int index = 0;
-  UtcTime utc;
-  double exposure = 1.0;
-  cv::Mat rgb;
+  capture::FrameStatus status = capture::FrameStatus::kEnd;
+  capture::Frame frame;
   std::exception_ptr error;  // a failure that is not the frame's own: ends the run
 };
 
@@ -70,27 +65,19 @@ class FramePipeline {
   void Run() {
     while (!stop_) {
       DecodedFrame frame;
-      bool end = false;
       try {
-        capture::Frame f;
-        const capture::FrameStatus status = source_->Next(&f);
-        if (status == capture::FrameStatus::kWaiting) continue;
-        end = status == capture::FrameStatus::kEnd;
-        frame.end = end;
-        frame.ok = status == capture::FrameStatus::kFrame;
-        frame.linear = f.linear;
-        frame.index = f.index, frame.utc = f.utc, frame.exposure = f.exposure;
-        frame.rgb = f.rgb;
+        frame.status = source_->Next(&frame.frame);
+        if (frame.status == capture::FrameStatus::kWaiting) continue;
       } catch (...) {
         frame.error = std::current_exception();
       }
-      const bool failed = static_cast<bool>(frame.error) || end;
+      const bool last = static_cast<bool>(frame.error) || frame.status == capture::FrameStatus::kEnd;
       try {
         queue_.push(std::move(frame));  // waits while the estimation is 4 frames behind
       } catch (const tbb::user_abort&) {
         return;
       }
-      if (failed) return;
+      if (last) return;
     }
   }
 
@@ -128,8 +115,10 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
   std::optional<UtcTime> first;
   for (size_t i = 0; !total || i < *total; ++i) {
     if (options.stop != nullptr && options.stop->load()) break;
-    const DecodedFrame decoded = frames.Next();
-    if (decoded.end) break;
+    const DecodedFrame next = frames.Next();
+    if (next.status == capture::FrameStatus::kEnd) break;
+    const bool ok = next.status == capture::FrameStatus::kFrame;
+    const capture::Frame& decoded = next.frame;
     FrameEstimate row;
     row.frame = decoded.index;
     row.time_utc = decoded.utc;
@@ -138,10 +127,10 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
     row.sun_azimuth_deg = sun.azimuth_deg;
     if (!first) first = decoded.utc;
     const double t_s = decoded.utc.SecondsSince(*first);
-    if (!decoded.ok || decoded.rgb.cols != bake.camera.width || decoded.rgb.rows != bake.camera.height) {
+    if (!ok || decoded.rgb.cols != bake.camera.width || decoded.rgb.rows != bake.camera.height) {
       row.decoded = false;
       ++run.undecodable;
-      if (decoded.ok) {
+      if (ok) {
         Log().warn("{}: frame {} is {}x{}, not the camera's {}x{}; skipped", scene.file.string(), row.frame,
                    decoded.rgb.cols, decoded.rgb.rows, bake.camera.width, bake.camera.height);
       }
