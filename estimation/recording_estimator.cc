@@ -108,11 +108,12 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
   if (scene.frame_times) total = scene.frame_times->frames.size();
   if (options.max_frames) total = std::min(total.value_or(SIZE_MAX), static_cast<size_t>(*options.max_frames));
   std::optional<Progress> progress;
-  if (total) progress.emplace("estimate", *total);
+  if (total) progress.emplace(options.progress_label, *total);
   const Clock::time_point start = Clock::now();
   std::vector<double> frame_ms;  // estimation after decoding, frames without a sun move
   FramePipeline frames(std::move(source));
   std::optional<UtcTime> first;
+  double overcast_share = 0.0;  // the last usable fit's, held like the light
   for (size_t i = 0; !total || i < *total; ++i) {
     if (options.stop != nullptr && options.stop->load()) break;
     const DecodedFrame next = frames.Next();
@@ -137,11 +138,16 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
       const FilteredLight held = filter.Update(t_s, std::nullopt, 0.0);
       row.light = held.light, row.confidence = held.confidence;
       run.frames.push_back(row);
+      if (options.on_frame) {
+        const glm::vec3 sun_dir(geo.DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg));
+        options.on_frame(row, capture::Frame{}, sun_dir, overcast_share);
+      }
       if (progress) progress->Advance();
       continue;
     }
     const Clock::time_point began = Clock::now();
-    const bool moved = sampler.SetSun(glm::vec3(geo.DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg)));
+    const glm::vec3 sun_dir(geo.DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg));
+    const bool moved = sampler.SetSun(sun_dir);
     const std::vector<Sample> samples = sampler.Draw(decoded.rgb, decoded.exposure, decoded.linear ? nullptr : &linearizer);
     const SunSkyFitSummary fit = FitSunSky(options.fit, samples);
     const FilteredLight filtered =
@@ -152,10 +158,12 @@ EstimateRun EstimateRecording(const scene::Scene& scene, const bake::SceneBake& 
     } else {
       frame_ms.push_back(ms);
     }
+    if (fit.IsUsable()) overcast_share = fit.overcast_share;
     row.light = filtered.light;
     row.confidence = filtered.confidence;
     row.samples = static_cast<int>(samples.size());
     run.frames.push_back(row);
+    if (options.on_frame) options.on_frame(row, decoded, sun_dir, overcast_share);
     const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
     const double fps = static_cast<double>(i + 1) / std::max(elapsed, 1e-9);
     if (progress) {

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,12 +19,22 @@
 
 namespace daylit::estimation {
 
+struct FrameEstimate;
+
+// What a replay does with each frame after its estimate (render it, say), on the estimating
+// thread. `frame` is empty (no pixels) when it could not be read; `sun_dir` is unit, in scene
+// coordinates; `overcast_share` is the fit's E_overcast / E_sky (0 when the frame had no usable fit).
+using FrameHook = std::function<void(const FrameEstimate& row, const capture::Frame& frame, const glm::vec3& sun_dir,
+                                     double overcast_share)>;
+
 struct EstimateOptions {
   SamplerOptions sampler;
   SunSkyFitOptions fit;
   TemporalFilterOptions filter;
   std::optional<int> max_frames;              // stop after this many (a live camera runs until stopped)
   const std::atomic<bool>* stop = nullptr;    // set (e.g. by Ctrl-C) to end the run after the frame at hand
+  FrameHook on_frame;                          // optional, called once per frame in order
+  std::string progress_label = "estimate";
 };
 
 struct FrameEstimate {

@@ -112,4 +112,8 @@ Scene LoadScene(const std::filesystem::path& path);
 // falling back to camera.exposure), or its live device.
 std::unique_ptr<capture::FrameSource> OpenFrameSource(const Scene& scene);
 
+// The frame rate a video of the scene's frames plays at: a device's `fps`, else one over the
+// median step of frames.csv (a recording may come in bursts; its times stay the truth).
+double NominalFps(const Scene& scene);
+
 }  // namespace daylit::scene

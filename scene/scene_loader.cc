@@ -3,6 +3,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "base/statistics.h"
 #include "capture/frame_source.h"
 #include "capture/v4l2_source.h"
 #include "scene/json_fields.h"
@@ -372,6 +373,15 @@ std::unique_ptr<capture::FrameSource> OpenFrameSource(const Scene& scene) {
   options.settings = scene.frames.controls;
   options.exposure = scene.exposure;
   return capture::OpenV4l2Source(scene.frames.device, options);
+}
+
+double NominalFps(const Scene& scene) {
+  if (scene.frames.kind == FrameSourceKind::kDevice || !scene.frame_times) return scene.frames.fps;
+  const std::vector<capture::FrameTime>& times = scene.frame_times->frames;
+  std::vector<double> steps;
+  for (size_t i = 1; i < times.size(); ++i) steps.push_back(times[i].utc.SecondsSince(times[i - 1].utc));
+  const double step = MedianInPlace(steps, 1.0 / 30.0);
+  return step > 0.0 ? 1.0 / step : 30.0;
 }
 
 double VirtualObject::BoundingRadius() const {

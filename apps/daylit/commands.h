@@ -15,5 +15,6 @@ void AddLightsCommand(CLI::App& app);
 void AddCalibrateCommands(CLI::App& app);
 void AddRecordCommand(CLI::App& app);
 void AddRenderCommand(CLI::App& app);
+void AddReplayCommand(CLI::App& app);
 
 }  // namespace daylit::app

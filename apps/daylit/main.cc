@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   daylit::app::AddCalibrateCommands(app);
   daylit::app::AddRecordCommand(app);
   daylit::app::AddRenderCommand(app);
+  daylit::app::AddReplayCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -19,7 +19,6 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "base/progress.h"
-#include "base/statistics.h"
 #include "capture/recording_writer.h"
 #include "capture/v4l2_source.h"
 #include "scene/scene.h"
@@ -106,13 +105,8 @@ void RunRecord(const RecordOptions& o) {
   } else {
     if (!scene.frame_times) ThrowInputError("--from: {} has no recorded frames", o.from);
     source = scene::OpenFrameSource(scene);
-    // The video's nominal rate: the median step between frames (a recording may come in bursts).
-    const auto& times = scene.frame_times->frames;
-    std::vector<double> steps;
-    for (size_t i = 1; i < times.size(); ++i) steps.push_back(times[i].utc.SecondsSince(times[i - 1].utc));
-    const double step = MedianInPlace(steps, 1.0 / 30.0);
-    if (step > 0.0) fps = 1.0 / step;
-    total = times.size();
+    fps = scene::NominalFps(scene);
+    total = scene.frame_times->frames.size();
   }
   if (o.frames) total = total ? std::min(*total, static_cast<size_t>(*o.frames)) : static_cast<size_t>(*o.frames);
   Log().info("recording {} into {}", source->Describe(), out.string());

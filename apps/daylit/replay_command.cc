@@ -1,0 +1,251 @@
+// daylit replay: the main job. Every frame of a recording through the whole pipeline (bake,
+// capture, sun, estimation, relighting, irradiance volume, compositing) into an augmented H.264
+// video, with the estimates, their plot and a report beside it (docs/render.md).
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "apps/daylit/commands.h"
+#include "bake/bake.h"
+#include "base/atomic_file.h"
+#include "base/error.h"
+#include "base/log.h"
+#include "base/statistics.h"
+#include "capture/response.h"
+#include "capture/video_encoder.h"
+#include "estimation/recording_estimator.h"
+#include "render/composite_truth.h"
+#include "render/frame_renderer.h"
+#include "render/gl_context.h"
+#include "report/plot.h"
+#include "scene/hdr_image.h"
+#include "scene/scene.h"
+
+namespace daylit::app {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+std::atomic<bool> g_stop_replay{false};
+extern "C" void StopReplay(int) { g_stop_replay = true; }
+
+struct ReplayOptions {
+  std::string recording;
+  std::string cache;
+  std::string out = "replay.mp4";
+  std::optional<int> frames;
+};
+
+// The path tracer's frames with the objects, where the recording has them (groundtruth/).
+class TruthComposites {
+ public:
+  explicit TruthComposites(const scene::Scene& scene) {
+    if (scene.groundtruth.composites) dir_ = *scene.groundtruth.composites;
+  }
+  // The comparison of `composite` with frame `index`'s truth; nullopt where there is none.
+  std::optional<render::CompositeFidelity> Compare(int index, const std::vector<float>& composite,
+                                                   const std::vector<float>& linear_frame, int w, int h,
+                                                   std::vector<float>* truth) const {
+    if (dir_.empty()) return std::nullopt;
+    const fs::path with_file = dir_ / "with_objects" / fmt::format("{:06d}.exr", index);
+    const fs::path without_file = dir_ / "without_objects" / fmt::format("{:06d}.exr", index);
+    const fs::path mask_file = dir_ / "objects_mask" / fmt::format("{:06d}.png", index);
+    if (!fs::is_regular_file(with_file) || !fs::is_regular_file(without_file) || !fs::is_regular_file(mask_file)) {
+      return std::nullopt;
+    }
+    scene::HdrImage with = scene::ReadHdrImage(with_file);
+    const scene::HdrImage without = scene::ReadHdrImage(without_file);
+    const cv::Mat mask = cv::imread(mask_file.string(), cv::IMREAD_GRAYSCALE);
+    if (with.width != w || with.height != h || without.width != w || without.height != h || mask.cols != w ||
+        mask.rows != h) {
+      ThrowInputError("{}: the truth of frame {} is not {}x{}", dir_.string(), index, w, h);
+    }
+    const render::CompositeFidelity f = render::CompareComposite(composite, linear_frame, with.rgb, without.rgb, mask);
+    *truth = std::move(with.rgb);
+    return f;
+  }
+
+ private:
+  fs::path dir_;
+};
+
+struct FrameFidelity {
+  int frame = 0;
+  render::CompositeFidelity f;
+};
+
+std::string FidelityCsv(const std::vector<FrameFidelity>& rows) {
+  std::string csv = "frame,object_error,object_pixels,shadow_error,shadow_pixels,frame_shadow_error\n";
+  for (const FrameFidelity& r : rows) {
+    csv += fmt::format("{},{:.5f},{},{:.5f},{},{:.5f}\n", r.frame, r.f.object_error, r.f.object_pixels, r.f.shadow_error,
+                       r.f.shadow_pixels, r.f.frame_shadow_error);
+  }
+  return csv;
+}
+
+void PlotFidelity(const std::vector<FrameFidelity>& rows, const std::string& title, const fs::path& png) {
+  report::LinePlot plot({title + ": composite against the path-traced truth", "frame", "mean relative error (%)", 1400,
+                         420, true});
+  report::Series objects{"objects", {}, {}, report::SeriesColor(0), false, false};
+  report::Series shadows{"their shadows", {}, {}, report::SeriesColor(1), false, false};
+  report::Series camera{"the frame itself on the shadow pixels", {}, {}, report::SeriesColor(7), true, false};
+  for (const FrameFidelity& r : rows) {
+    objects.x.push_back(r.frame), objects.y.push_back(100 * r.f.object_error);
+    shadows.x.push_back(r.frame), shadows.y.push_back(100 * r.f.shadow_error);
+    camera.x.push_back(r.frame), camera.y.push_back(100 * r.f.frame_shadow_error);
+  }
+  plot.Add(std::move(objects));
+  plot.Add(std::move(shadows));
+  plot.Add(std::move(camera));
+  report::WritePng(png, {plot.Render()});
+}
+
+void RunReplay(const ReplayOptions& o) {
+  const fs::path out(o.out);
+  const std::string ext = out.extension().string();
+  if (ext != ".mp4" && ext != ".mkv") ThrowInputError("--out: {} must end in .mp4 or .mkv", o.out);
+  if (o.frames && *o.frames < 1) ThrowInputError("--frames: {} is not a number of frames", *o.frames);
+  const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
+  const scene::Scene scene = scene::LoadScene(o.recording);
+  // Everything that can fail without the bake fails before it: the frames, GL, the output.
+  std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
+  std::string why;
+  const auto gl = render::HeadlessGlContext::Create(&why);
+  if (gl == nullptr) ThrowInputError("OpenGL: {}", why);
+  if (!fs::is_directory(dir)) ThrowInputError("--out: {}: no such folder", dir.string());
+  fs::path partial = TemporarySibling(out);
+  partial += ext;  // the container is chosen by the extension
+  struct RemoveUnlessCommitted {
+    fs::path path;
+    ~RemoveUnlessCommitted() {
+      std::error_code ec;
+      if (!path.empty()) fs::remove(path, ec);
+    }
+  } cleanup{partial};
+  const double fps = scene::NominalFps(scene);
+  capture::VideoEncoder encoder(partial, scene.intrinsics.width, scene.intrinsics.height, capture::VideoEncoderOptions{fps});
+
+  bool loaded = false;
+  const fs::path cache = bake::CacheDir(scene, o.cache);
+  const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, cache, &loaded);
+  Log().info("{} the bake: {}", loaded ? "loaded" : "made", cache.string());
+  const scene::RayCaster caster(scene.model);
+  render::FrameRenderer renderer(scene, baked, caster);
+  Log().info("rendering with {} ({})", gl->renderer(), gl->platform());
+  const int w = renderer.width(), h = renderer.height();
+
+  const TruthComposites truth(scene);
+  std::vector<FrameFidelity> fidelity;
+  double worst = -1.0;
+  std::vector<float> composite, truth_frame;
+  cv::Mat last = cv::Mat::zeros(h, w, CV_8UC3);
+  std::vector<double> render_ms, encode_ms;
+  estimation::EstimateOptions options;
+  options.max_frames = o.frames;
+  options.progress_label = "replay";
+  g_stop_replay = false;
+  options.stop = &g_stop_replay;
+  options.on_frame = [&](const estimation::FrameEstimate& row, const capture::Frame& frame, const glm::vec3& sun_dir,
+                         double overcast_share) {
+    // A frame that could not be read shows the last one again, so the video keeps its timing.
+    if (frame.rgb.empty()) {
+      encoder.Write(last);
+      return;
+    }
+    const Clock::time_point t0 = Clock::now();
+    renderer.Render(frame, row.light, overcast_share, sun_dir, &composite);
+    const Clock::time_point t1 = Clock::now();
+    last = capture::EncodeToBgr8(composite.data(), w, h, frame.exposure, &scene.response);
+    encoder.Write(last);
+    const Clock::time_point t2 = Clock::now();
+    render_ms.push_back(1e3 * std::chrono::duration<double>(t1 - t0).count());
+    encode_ms.push_back(1e3 * std::chrono::duration<double>(t2 - t1).count());
+    if (const auto f = truth.Compare(frame.index, composite, renderer.linear_frame(), w, h, &truth_frame)) {
+      fidelity.push_back({frame.index, *f});
+      const double score = std::max(f->object_error, f->shadow_error);
+      if (score > worst) {
+        worst = score;
+        render::WriteCompositeStrip(dir / "worst_vs_truth.png", w, h, truth_frame, composite, frame.exposure,
+                                    scene.response);
+      }
+    }
+  };
+  std::signal(SIGINT, StopReplay);
+  const estimation::EstimateRun run = estimation::EstimateRecording(scene, baked, options, std::move(source));
+  std::signal(SIGINT, SIG_DFL);
+  encoder.Finish();
+  CommitTemporary(partial, out);
+  cleanup.path.clear();
+
+  const size_t n = run.frames.size();
+  fmt::memory_buffer report;
+  auto say = [&report](const std::string& line) {
+    fmt::print("{}\n", line);
+    fmt::format_to(std::back_inserter(report), "{}\n", line);
+  };
+  say(fmt::format("{}: {} frames in {:.1f} s, {:.1f} fps end to end (decode, estimate, relight, render, encode)",
+                  scene.name, n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9)));
+  say(fmt::format("  per frame (median): estimate {:.1f} ms, relight + render {:.1f} ms, encode {:.1f} ms",
+                  run.median_frame_ms, MedianInPlace(render_ms, 0.0), MedianInPlace(encode_ms, 0.0)));
+  if (run.undecodable > 0) say(fmt::format("  {} frames could not be decoded (shown as the frame before)", run.undecodable));
+  WriteFileAtomically(dir / "estimates.csv", estimation::EstimatesCsv(run.frames));
+  std::optional<estimation::TruthComparison> lighting;
+  if (scene.groundtruth.lighting) {
+    lighting = estimation::CompareWithTruth(run.frames, *scene.groundtruth.lighting);
+    say(fmt::format("lighting against groundtruth.csv, median relative error over {} frames (R, G, B):", lighting->frames));
+    say(fmt::format("  E_sun    {:5.1f}% {:5.1f}% {:5.1f}%", 100 * lighting->sun_error.x, 100 * lighting->sun_error.y,
+                    100 * lighting->sun_error.z));
+    say(fmt::format("  E_sky    {:5.1f}% {:5.1f}% {:5.1f}%", 100 * lighting->sky_error.x, 100 * lighting->sky_error.y,
+                    100 * lighting->sky_error.z));
+  }
+  estimation::PlotEstimates(run.frames, lighting ? &*lighting : nullptr, scene.name, dir / "lighting.png");
+  if (!fidelity.empty()) {
+    double objects = 0.0, shadows = 0.0;
+    const FrameFidelity* worst_objects = &fidelity[0];
+    const FrameFidelity* worst_shadows = &fidelity[0];
+    for (const FrameFidelity& r : fidelity) {
+      objects += r.f.object_error / static_cast<double>(fidelity.size());
+      shadows += r.f.shadow_error / static_cast<double>(fidelity.size());
+      if (r.f.object_error > worst_objects->f.object_error) worst_objects = &r;
+      if (r.f.shadow_error > worst_shadows->f.shadow_error) worst_shadows = &r;
+    }
+    say(fmt::format("composite against the path-traced truth over {} frames (mean relative error of linear radiance):",
+                    fidelity.size()));
+    say(fmt::format("  objects        {:5.1f}% (worst {:.1f}% at frame {})", 100 * objects,
+                    100 * worst_objects->f.object_error, worst_objects->frame));
+    say(fmt::format("  their shadows  {:5.1f}% (worst {:.1f}% at frame {})", 100 * shadows,
+                    100 * worst_shadows->f.shadow_error, worst_shadows->frame));
+    WriteFileAtomically(dir / "fidelity.csv", FidelityCsv(fidelity));
+    PlotFidelity(fidelity, scene.name, dir / "fidelity.png");
+  }
+  WriteFileAtomically(dir / "report.txt", fmt::to_string(report));
+  Log().info("wrote {}, estimates.csv, lighting.png, report.txt{} in {}", out.filename().string(),
+             fidelity.empty() ? "" : ", fidelity.csv, fidelity.png, worst_vs_truth.png", dir.string());
+}
+
+}  // namespace
+
+void AddReplayCommand(CLI::App& app) {
+  auto options = std::make_shared<ReplayOptions>();
+  CLI::App* cmd = app.add_subcommand("replay", "The whole pipeline over a recording, into an augmented video");
+  cmd->footer("Bakes (cached), then for every frame: decode, sun, estimate, relight the env map, update the\n"
+              "irradiance volume, composite the objects with OpenGL (EGL, no display needed), encode H.264.\n"
+              "Beside the video: estimates.csv, lighting.png, report.txt; with the recording's ground truth,\n"
+              "fidelity.csv, fidelity.png and worst_vs_truth.png. Ctrl-C ends it with a complete video.");
+  cmd->add_option("recording", options->recording, "Recording folder or its scene.json")->required();
+  cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
+  cmd->add_option("--out", options->out, "Augmented video, .mp4 or .mkv (default replay.mp4)");
+  cmd->add_option("--frames", options->frames, "Stop after this many frames");
+  cmd->callback([options] { RunReplay(*options); });
+}
+
+}  // namespace daylit::app
