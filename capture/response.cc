@@ -81,6 +81,21 @@ void Linearizer::Apply(const float* encoded, float* linear, size_t count) const 
   for (size_t k = 0; k < count; ++k) linear[k] = (*this)(encoded[k], static_cast<int>(k % 3));
 }
 
+Encoder::Encoder(const CameraResponse& response) {
+  for (int c = 0; c < 3; ++c) {
+    for (int i = 0; i <= kSteps; ++i) {
+      const double s = static_cast<double>(i) / kSteps;
+      tables_[static_cast<size_t>(c)][static_cast<size_t>(i)] = static_cast<float>(response.ToEncoded(s * s, c));
+    }
+  }
+}
+
+void Encoder::Apply(const float* linear, float scale, float* encoded, size_t count) const {
+  for (size_t k = 0; k < count; k += 3) {
+    for (int c = 0; c < 3; ++c) encoded[k + static_cast<size_t>(c)] = (*this)(linear[k + static_cast<size_t>(c)] * scale, c);
+  }
+}
+
 std::string CameraResponse::Describe() const {
   switch (curve) {
     case ResponseCurve::kLinear: return "linear";

@@ -104,6 +104,21 @@ void EnvRelighter::Relight(const estimation::SunSky& light, double overcast_shar
   }
 }
 
+void EnvRelighter::Basis(EnvBasis* basis) const {
+  const bake::EnvMapMaps& env = bake_.env;
+  for (std::vector<glm::vec3>* map : {&basis->sun, &basis->clear, &basis->overcast}) map->assign(env.surface.size(), glm::vec3(0.0f));
+  for (size_t t = 0; t < sky_shape_.size(); ++t) {
+    basis->clear[t] = sky_shape_[t];
+    basis->overcast[t] = glm::vec3(glm::one_over_pi<float>());
+  }
+  for (size_t i = 0; i < model_texels_.size(); ++i) {
+    const estimation::Transfer& T = terms_[i];
+    const uint32_t t = model_texels_[i];
+    const glm::vec3 k = env.albedo[t] * glm::one_over_pi<float>();
+    basis->sun[t] = k * T.sun, basis->clear[t] = k * T.clear, basis->overcast[t] = k * T.overcast;
+  }
+}
+
 namespace {
 
 float Luminance(const glm::vec3& l) { return 0.2126f * l.x + 0.7152f * l.y + 0.0722f * l.z; }

@@ -28,6 +28,12 @@
 
 namespace daylit::relight {
 
+// The relit map per unit of each light, per channel: Relight gives
+// E_sun·sun + (1 − o)·E_sky·clear + o·E_sky·overcast, texel by texel.
+struct EnvBasis {
+  std::vector<glm::vec3> sun, clear, overcast;
+};
+
 class EnvRelighter {
  public:
   // `bake`, `caster` must outlive this.
@@ -41,6 +47,9 @@ class EnvRelighter {
   // The relit radiance of every texel (row-major, like the map): `light` the estimated E_sun
   // and E_sky, `overcast_share` the share of E_sky from a uniform overcast sky.
   void Relight(const estimation::SunSky& light, double overcast_share, std::vector<glm::vec3>* radiance) const;
+
+  // The three maps Relight combines, for the current sun.
+  void Basis(EnvBasis* basis) const;
 
   int width() const { return bake_.env.width; }
   int height() const { return bake_.env.height; }

@@ -119,7 +119,7 @@ glm::vec3 IrradianceVolume::Irradiance(const glm::vec3& point, const glm::vec3& 
   return glm::max(Integrate(point, EvalSh9(glm::dvec3(normal))), glm::vec3(0.0f));
 }
 
-glm::vec3 IrradianceVolume::Integrate(const glm::vec3& point, const Sh9Basis& y) const {
+void IrradianceVolume::Corners(const glm::vec3& point, std::array<size_t, 8>* probes, std::array<float, 8>* weights) const {
   const glm::ivec3 n = gather_.resolution;
   // Continuous probe coordinates, clamped into the grid.
   glm::vec3 g;
@@ -130,14 +130,23 @@ glm::vec3 IrradianceVolume::Integrate(const glm::vec3& point, const Sh9Basis& y)
   }
   const glm::ivec3 i0 = glm::min(glm::ivec3(g), glm::max(n - 2, glm::ivec3(0)));
   const glm::vec3 f = g - glm::vec3(i0);
-  glm::vec3 e(0.0f);
   for (int corner = 0; corner < 8; ++corner) {
     const glm::ivec3 o((corner & 1) != 0, (corner & 2) != 0, (corner & 4) != 0);
     const glm::ivec3 q = glm::min(i0 + o, n - 1);
     float w = 1.0f;
     for (int a = 0; a < 3; ++a) w *= o[a] ? f[a] : 1.0f - f[a];
-    if (w == 0.0f) continue;
-    e += w * Evaluate((static_cast<size_t>(q.z) * n.y + q.y) * n.x + q.x, y);
+    (*probes)[static_cast<size_t>(corner)] = (static_cast<size_t>(q.z) * n.y + q.y) * n.x + q.x;
+    (*weights)[static_cast<size_t>(corner)] = w;
+  }
+}
+
+glm::vec3 IrradianceVolume::Integrate(const glm::vec3& point, const Sh9Basis& y) const {
+  std::array<size_t, 8> probes;
+  std::array<float, 8> weights;
+  Corners(point, &probes, &weights);
+  glm::vec3 e(0.0f);
+  for (size_t corner = 0; corner < 8; ++corner) {
+    if (weights[corner] != 0.0f) e += weights[corner] * Evaluate(probes[corner], y);
   }
   return e;
 }

@@ -15,6 +15,7 @@
 // E(n) = Σ_c coefficient_c · Y_c(n), no further factors.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -42,6 +43,9 @@ class IrradianceVolume {
   // volume): Irradiance() with weights Y_c(n); other weights integrate other lobes, e.g. the
   // light arriving from a set of directions.
   glm::vec3 Integrate(const glm::vec3& point, const Sh9Basis& weights) const;
+  // The trilinear interpolation at `point` (clamped into the volume): eight probes (indices into
+  // the probe-major layout) and their weights, summing to 1.
+  void Corners(const glm::vec3& point, std::array<size_t, 8>* probes, std::array<float, 8>* weights) const;
   // The same at probe (i, j, k), no interpolation.
   glm::vec3 ProbeIrradiance(int i, int j, int k, const glm::vec3& normal) const;
 

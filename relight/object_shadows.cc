@@ -1,8 +1,10 @@
 #include "relight/object_shadows.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
+#include <opencv2/imgproc.hpp>
 #include <tbb/parallel_for.h>
 
 #include <glm/gtc/constants.hpp>
@@ -89,8 +91,42 @@ ObjectShadows::ObjectShadows(const scene::Scene& scene, const bake::SceneBake& b
     found[i].first = static_cast<uint32_t>(covered_texels_.size());
     found[i].count = static_cast<uint32_t>(texels[i].size());
     covered_texels_.insert(covered_texels_.end(), texels[i].begin(), texels[i].end());
+    FindNeighbours(&found[i]);
     affected_.push_back(found[i]);
   }
+  pi_over_albedo_.resize(pixels);
+  for (size_t p = 0; p < pixels; ++p) pi_over_albedo_[p] = glm::pi<float>() / glm::max(gbuffer.albedo[p], glm::vec3(1e-3f));
+}
+
+constexpr uint32_t kAllNeighbours = (1u << 25) - 1;
+
+void ObjectShadows::FindNeighbours(Affected* a) const {
+  const int w = gbuffer_.width, h = gbuffer_.height;
+  const int x = static_cast<int>(a->pixel % static_cast<uint32_t>(w)), y = static_cast<int>(a->pixel / static_cast<uint32_t>(w));
+  a->neighbours = 0;
+  for (int dy = -2; dy <= 2; ++dy) {
+    for (int dx = -2; dx <= 2; ++dx) {
+      const int u = x + dx, v = y + dy;
+      if (u < 0 || v < 0 || u >= w || v >= h) continue;
+      const size_t q = static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u);
+      if (gbuffer_.surface[q] == gbuffer_.surface[a->pixel]) a->neighbours |= 1u << ((dy + 2) * 5 + dx + 2);
+    }
+  }
+}
+
+void ObjectShadows::SetEnvBasis(const EnvBasis& basis) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, affected_.size(), 1024), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      Affected& a = affected_[i];
+      glm::vec3 sun(0.0f), clear(0.0f), overcast(0.0f);
+      for (uint32_t k = a.first; k < a.first + a.count; ++k) {
+        const uint32_t t = covered_texels_[k];
+        sun += basis.sun[t], clear += basis.clear[t], overcast += basis.overcast[t];
+      }
+      a.covered_sun = ray_weight_ * sun, a.covered_clear = ray_weight_ * clear, a.covered_overcast = ray_weight_ * overcast;
+    }
+  });
+  has_basis_ = true;
 }
 
 bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
@@ -121,7 +157,10 @@ bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
       }
     }
   }
-  for (const uint32_t p : passing) affected_.push_back(Affected{p});
+  for (const uint32_t p : passing) {
+    affected_.push_back(Affected{p});
+    FindNeighbours(&affected_.back());
+  }
   tbb::parallel_for(tbb::blocked_range<size_t>(0, affected_.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
       Affected& a = affected_[i];
@@ -147,42 +186,55 @@ bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
   return true;
 }
 
-void ObjectShadows::Apply(const estimation::SunSky& light, const std::vector<glm::vec3>* env, float* rgb) const {
+void ObjectShadows::Apply(const estimation::SunSky& light, double overcast_share, float* rgb) {
   // B, the irradiance each pixel shows, from the frame itself: π·L/ρ, averaged over the pixel's
   // 5×5 neighbours on the same surface so that the camera's noise is not read as light. The
-  // pixel then keeps the share (B − ΔB)/B of its own value, noise included.
-  const int w = gbuffer_.width, h = gbuffer_.height;
-  std::vector<glm::vec3> keep(affected_.size());
-  for (size_t i = 0; i < affected_.size(); ++i) {
-    const Affected& a = affected_[i];
-    glm::vec3 lost = glm::vec3(light.sun_rgb) * (a.cos_sun * (a.sun_real - a.sun_with));
-    if (a.covers && env != nullptr) {
-      glm::vec3 sum(0.0f);
-      for (uint32_t k = a.first; k < a.first + a.count; ++k) sum += (*env)[covered_texels_[k]];
-      lost += ray_weight_ * sum;
-    } else if (a.covers) {
-      lost += glm::vec3(light.sky_rgb) * a.sky_lost;
-    }
-    const int x = static_cast<int>(a.pixel % static_cast<uint32_t>(w)), y = static_cast<int>(a.pixel / static_cast<uint32_t>(w));
-    glm::vec3 b(0.0f);
-    int n = 0;
-    for (int dy = -2; dy <= 2; ++dy) {
-      for (int dx = -2; dx <= 2; ++dx) {
-        const int u = x + dx, v = y + dy;
-        if (u < 0 || v < 0 || u >= w || v >= h) continue;
-        const size_t q = static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u);
-        if (gbuffer_.surface[q] != gbuffer_.surface[a.pixel]) continue;
-        const float* l = rgb + 3 * q;
-        b += glm::pi<float>() * glm::vec3(l[0], l[1], l[2]) / glm::max(gbuffer_.albedo[q], glm::vec3(1e-3f));
-        ++n;
+  // pixel then keeps the share (B − ΔB)/B of its own value, noise included. All B are read
+  // before any pixel changes.
+  const int w = gbuffer_.width;
+  const glm::vec3 sun(light.sun_rgb), sky(light.sky_rgb);
+  const float o = static_cast<float>(std::clamp(overcast_share, 0.0, 1.0));
+  const glm::vec3 clear = (1.0f - o) * sky, overcast = o * sky;
+  keep_.resize(affected_.size());
+  if (affected_.empty()) return;
+  // Where all 25 neighbours are on the pixel's surface (most pixels), B is a 5×5 box filter of
+  // π·L/ρ over the rows the affected pixels span.
+  const int h = gbuffer_.height;
+  const int row0 = std::max(0, static_cast<int>(affected_.front().pixel / static_cast<uint32_t>(w)) - 2);
+  const int row1 = std::min(h, static_cast<int>(affected_.back().pixel / static_cast<uint32_t>(w)) + 3);
+  const cv::Mat light_rows(row1 - row0, w, CV_32FC3, rgb + static_cast<size_t>(row0) * w * 3);
+  const cv::Mat weight_rows(row1 - row0, w, CV_32FC3, pi_over_albedo_.data() + static_cast<size_t>(row0) * w);
+  cv::multiply(light_rows, weight_rows, weighted_);
+  cv::boxFilter(weighted_, box_, -1, cv::Size(5, 5), cv::Point(-1, -1), true, cv::BORDER_CONSTANT);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, affected_.size(), 2048), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const Affected& a = affected_[i];
+      glm::vec3 lost = sun * (a.cos_sun * (a.sun_real - a.sun_with));
+      if (a.covers) {
+        lost += has_basis_ ? sun * a.covered_sun + clear * a.covered_clear + overcast * a.covered_overcast : sky * a.sky_lost;
       }
+      glm::vec3 b(0.0f);
+      if (a.neighbours == kAllNeighbours) {
+        const cv::Vec3f& mean = box_.at<cv::Vec3f>(static_cast<int>(a.pixel / static_cast<uint32_t>(w)) - row0,
+                                                   static_cast<int>(a.pixel % static_cast<uint32_t>(w)));
+        b = glm::vec3(mean[0], mean[1], mean[2]);
+      } else {
+        int n = 0;
+        for (uint32_t bits = a.neighbours; bits != 0; bits &= bits - 1) {
+          const int bit = std::countr_zero(bits);
+          const ptrdiff_t q = static_cast<ptrdiff_t>(a.pixel) + (bit / 5 - 2) * w + (bit % 5 - 2);
+          const float* l = rgb + 3 * q;
+          b += glm::vec3(l[0], l[1], l[2]) * pi_over_albedo_[static_cast<size_t>(q)];
+          ++n;
+        }
+        b /= static_cast<float>(std::max(n, 1));
+      }
+      for (int c = 0; c < 3; ++c) keep_[i][c] = b[c] > 0.0f ? std::clamp(1.0f - lost[c] / b[c], 0.0f, 1.0f) : 1.0f;
     }
-    b /= static_cast<float>(std::max(n, 1));
-    for (int c = 0; c < 3; ++c) keep[i][c] = b[c] > 0.0f ? std::clamp(1.0f - lost[c] / b[c], 0.0f, 1.0f) : 1.0f;
-  }
+  });
   for (size_t i = 0; i < affected_.size(); ++i) {
     float* p = rgb + 3 * static_cast<size_t>(affected_[i].pixel);
-    for (int c = 0; c < 3; ++c) p[c] *= keep[i][c];
+    for (int c = 0; c < 3; ++c) p[c] *= keep_[i][c];
   }
 }
 

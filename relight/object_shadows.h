@@ -21,9 +21,11 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <opencv2/core.hpp>
 
 #include "bake/bake.h"
 #include "estimation/lighting_model.h"
+#include "relight/env_relight.h"
 #include "scene/raycaster.h"
 #include "scene/scene.h"
 
@@ -47,11 +49,15 @@ class ObjectShadows {
   // was). Returns whether it did.
   bool SetSun(const glm::vec3& sun_dir);
 
+  // The light from the directions the objects cover, per unit of each light, from the relit
+  // map's basis (EnvRelighter::Basis) for the current sun: call it whenever that changes. Until
+  // then a covered direction carries E_sky per unit solid angle share.
+  void SetEnvBasis(const EnvBasis& basis);
+
   // Takes the objects' share from a linear RGB frame in radiance units (camera size, row-major, 3
-  // floats per pixel) under `light`, with the light from covered directions read from `env`, the
-  // relit map of this frame (EnvRelighter::Relight), or, when null, from E_sky; pixels the objects
-  // do not touch are left exactly as they were.
-  void Apply(const estimation::SunSky& light, const std::vector<glm::vec3>* env, float* rgb) const;
+  // floats per pixel) under `light` with its overcast share (as EnvRelighter::Relight); pixels
+  // the objects do not touch are left exactly as they were.
+  void Apply(const estimation::SunSky& light, double overcast_share, float* rgb);
 
   // Pixels that lose light from directions an object covers, and those in an object's sun shadow.
   size_t SkyLossPixels() const;
@@ -66,7 +72,10 @@ class ObjectShadows {
     uint32_t first = 0, count = 0;  // its covered rays' env texels in covered_texels_
     float sun_real = 0.0f;   // s: the share of the sun's disc the point sees past the real model
     float sun_with = 0.0f;   // s': the same past the objects too
+    uint32_t neighbours = 0;  // bit (dy + 2)·5 + dx + 2: the 5×5 neighbour is on the frame and the same surface
+    glm::vec3 covered_sun{0.0f}, covered_clear{0.0f}, covered_overcast{0.0f};  // ray_weight·Σ basis over covered rays
   };
+  void FindNeighbours(Affected* a) const;
 
   const bake::CameraGBuffer& gbuffer_;
   const scene::RayCaster& real_;
@@ -76,6 +85,10 @@ class ObjectShadows {
   std::vector<Affected> affected_;  // sorted by pixel
   std::vector<uint32_t> covered_texels_;
   float ray_weight_ = 0.0f;         // π/N: E = ray_weight · Σ L over covered rays
+  bool has_basis_ = false;
+  std::vector<glm::vec3> pi_over_albedo_;  // per camera pixel: B = π·L/ρ
+  std::vector<glm::vec3> keep_;  // Apply's scratch
+  cv::Mat weighted_, box_;
   std::vector<glm::vec3> disc_;     // directions over the sun's disc
   glm::vec3 sun_{0.0f};
   bool has_sun_ = false;

@@ -1,6 +1,8 @@
 #include "render/compositor.h"
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <cmath>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -9,6 +11,7 @@
 #include "base/error.h"
 #include "render/gl_program.h"
 #include "render/projection.h"
+#include "relight/irradiance_volume.h"
 #include "scene/object_mesh.h"
 
 namespace daylit::render {
@@ -45,26 +48,32 @@ layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec3 sun_loss;
 layout(location = 3) in vec3 sky_loss;
+layout(location = 4) in vec3 sh[9];
 uniform mat4 clip_from_world;
 out vec3 world_position;
 out vec3 world_normal;
 out vec3 vertex_sun_loss;
 out vec3 vertex_sky_loss;
+out vec3 vertex_sh[9];
 void main() {
   world_position = position;
   world_normal = normal;
   vertex_sun_loss = sun_loss;
   vertex_sky_loss = sky_loss;
+  for (int c = 0; c < 9; ++c) vertex_sh[c] = sh[c];
   gl_Position = clip_from_world * vec4(position, 1.0);
 })";
 
 // ρ/π (E_sun v max(0, n·l) + Σ_c SH_c(p) Y_c(n)); Y_c as relight/sh9.h (the cosine lobe is in
-// the coefficients already).
+// the coefficients already). SH_c(p): the volume's trilinear coefficients at the vertices,
+// interpolated across the triangle (meshes are finer than the probe grid; the builtin ones are),
+// evaluated with the fragment's own normal.
 const char* kObjectFragment = R"(#version 330 core
 in vec3 world_position;
 in vec3 world_normal;
 in vec3 vertex_sun_loss;
 in vec3 vertex_sky_loss;
+in vec3 vertex_sh[9];
 uniform vec3 albedo;
 uniform vec3 sun_dir;
 uniform vec3 sun_rgb;
@@ -73,21 +82,17 @@ uniform mat4 shadow_from_world;
 uniform sampler2DShadow shadow_map;
 uniform float shadow_texel;
 uniform bool has_volume;
-uniform vec3 volume_min;
-uniform vec3 volume_max;
-uniform vec3 volume_n;
-uniform sampler3D sh0, sh1, sh2, sh3, sh4, sh5, sh6, sh7, sh8;
 out vec4 color;
 const float kPi = 3.14159265358979;
 
 float SunVisibility(vec3 p, vec3 n) {
-  // Offset along the normal against acne; 3×3 taps of hardware 2×2 PCF.
+  // Offset along the normal against acne; 2×2 taps a texel apart of hardware 2×2 PCF: a tent
+  // about 3 texels wide, near the sun's penumbra at the objects' scale.
   vec4 s = shadow_from_world * vec4(p + n * 4.0 * shadow_texel, 1.0);
   vec3 q = s.xyz / s.w * 0.5 + 0.5;
-  float v = 0.0;
-  for (int i = -1; i <= 1; ++i)
-    for (int j = -1; j <= 1; ++j) v += texture(shadow_map, vec3(q.xy + vec2(i, j) / textureSize(shadow_map, 0), q.z));
-  return v / 9.0;
+  vec2 d = vec2(0.5) / vec2(textureSize(shadow_map, 0));
+  return 0.25 * (texture(shadow_map, vec3(q.xy + vec2(-d.x, -d.y), q.z)) + texture(shadow_map, vec3(q.xy + vec2(d.x, -d.y), q.z)) +
+                 texture(shadow_map, vec3(q.xy + vec2(-d.x, d.y), q.z)) + texture(shadow_map, vec3(q.xy + vec2(d.x, d.y), q.z)));
 }
 
 void main() {
@@ -96,18 +101,16 @@ void main() {
   vec3 e = vec3(0.0);
   if (cos_l > 0.0) e += sun_rgb * cos_l * SunVisibility(world_position, n);
   if (has_volume) {
-    vec3 f = clamp((world_position - volume_min) / (volume_max - volume_min), 0.0, 1.0);
-    vec3 u = 0.5 / volume_n + f * (volume_n - 1.0) / volume_n;
     float x = n.x, y = n.y, z = n.z;
-    e += texture(sh0, u).rgb * 0.282095;
-    e += texture(sh1, u).rgb * 0.488603 * y;
-    e += texture(sh2, u).rgb * 0.488603 * z;
-    e += texture(sh3, u).rgb * 0.488603 * x;
-    e += texture(sh4, u).rgb * 1.092548 * x * y;
-    e += texture(sh5, u).rgb * 1.092548 * y * z;
-    e += texture(sh6, u).rgb * 0.315392 * (3.0 * z * z - 1.0);
-    e += texture(sh7, u).rgb * 1.092548 * x * z;
-    e += texture(sh8, u).rgb * 0.546274 * (x * x - y * y);
+    e += vertex_sh[0] * 0.282095;
+    e += vertex_sh[1] * 0.488603 * y;
+    e += vertex_sh[2] * 0.488603 * z;
+    e += vertex_sh[3] * 0.488603 * x;
+    e += vertex_sh[4] * 1.092548 * x * y;
+    e += vertex_sh[5] * 1.092548 * y * z;
+    e += vertex_sh[6] * 0.315392 * (3.0 * z * z - 1.0);
+    e += vertex_sh[7] * 1.092548 * x * z;
+    e += vertex_sh[8] * 0.546274 * (x * x - y * y);
     // The bounce from real ground the objects themselves shade (relight::ObjectBounce).
     e -= sun_rgb * vertex_sun_loss + sky_rgb * vertex_sky_loss;
   }
@@ -116,11 +119,37 @@ void main() {
 
 struct DrawMesh {
   GlVertexArray vao;
-  GlBuffer positions, normals, indices, sun_loss, sky_loss;
+  GlBuffer positions, normals, indices, sun_loss, sky_loss, sh;
   size_t vertices = 0;
+  std::vector<glm::vec3> world;  // the vertices, for the volume's interpolation
+  std::vector<std::array<size_t, 8>> corner_probes;  // per vertex, once the volume is known
+  std::vector<std::array<float, 8>> corner_weights;
   GLsizei count = 0;
   glm::vec3 albedo{0.5f};
+  bool closed = false;  // every edge shared by two triangles that traverse it in opposite directions
 };
+
+// Whether the triangles close a volume with outward (counter-clockwise) faces, vertices welded by
+// position: then the faces turned away from the camera are all hidden.
+bool IsClosed(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices) {
+  std::map<std::array<float, 3>, uint32_t> weld;
+  std::vector<uint32_t> id(positions.size());
+  for (size_t v = 0; v < positions.size(); ++v) {
+    id[v] = weld.emplace(std::array<float, 3>{positions[v].x, positions[v].y, positions[v].z}, static_cast<uint32_t>(weld.size())).first->second;
+  }
+  std::map<std::pair<uint32_t, uint32_t>, int> edges;  // directed edge → count
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+    const uint32_t a = id[indices[t]], b = id[indices[t + 1]], c = id[indices[t + 2]];
+    if (a == b || b == c || c == a) continue;  // degenerate (a pole's fan)
+    for (const auto& e : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
+      if (++edges[e] > 1) return false;
+    }
+  }
+  for (const auto& [e, count] : edges) {
+    if (edges.find({e.second, e.first}) == edges.end()) return false;
+  }
+  return !edges.empty();
+}
 
 DrawMesh Upload(const std::vector<glm::vec3>& positions, const std::vector<glm::vec3>* normals,
                 const std::vector<uint32_t>& indices) {
@@ -150,6 +179,18 @@ DrawMesh Upload(const std::vector<glm::vec3>& positions, const std::vector<glm::
       glEnableVertexAttribArray(location);
       glVertexAttribPointer(location, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
     }
+    // The volume's 9 RGB coefficients per vertex, interleaved; zero until a volume comes.
+    m.sh = NewBuffer();
+    glBindBuffer(GL_ARRAY_BUFFER, m.sh.get());
+    const std::vector<float> none(positions.size() * 27, 0.0f);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(none.size() * sizeof(float)), none.data(), GL_STREAM_DRAW);
+    for (GLuint c = 0; c < 9; ++c) {
+      glEnableVertexAttribArray(4 + c);
+      glVertexAttribPointer(4 + c, 3, GL_FLOAT, GL_FALSE, 27 * sizeof(float),
+                            reinterpret_cast<const void*>(static_cast<uintptr_t>(3 * c * sizeof(float))));
+    }
+    m.world = positions;
+    m.closed = IsClosed(positions, indices);
   }
   m.indices = NewBuffer();
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, m.indices.get());
@@ -168,9 +209,13 @@ void Draw(const DrawMesh& m) {
 
 struct Compositor::Gl {
   int width = 0, height = 0;
+  Rect rect;  // what is drawn: FBOs, textures and viewports are its size
   CompositorOptions options;
-  glm::mat4 clip_from_world{1.0f};
-  scene::VolumeSpec volume;
+  glm::mat4 clip_from_world{1.0f};  // for the rectangle's viewport
+  bool has_shadow_map = false;
+  glm::vec3 shadow_sun{0.0f};
+  glm::mat4 shadow_from_world{1.0f};
+  float shadow_texel = 0.0f;
   GlProgram background{kFullScreenVertex, kBackgroundFragment};
   GlProgram depth{kDepthVertex, kDepthFragment};
   GlProgram object{kObjectVertex, kObjectFragment};
@@ -182,40 +227,73 @@ struct Compositor::Gl {
   GlFramebuffer msaa = NewFramebuffer(), resolved = NewFramebuffer(), shadow = NewFramebuffer();
   GlRenderbuffer msaa_color = NewRenderbuffer(), msaa_depth = NewRenderbuffer(), resolved_color = NewRenderbuffer();
   GlTexture shadow_map = NewTexture();
-  GlTexture sh[9] = {NewTexture(), NewTexture(), NewTexture(), NewTexture(), NewTexture(),
-                     NewTexture(), NewTexture(), NewTexture(), NewTexture()};
-  std::vector<float> plane;  // one coefficient's RGB over the probes
+  std::vector<float> vertex_sh;  // one mesh's coefficients per vertex
   std::vector<float> readback;
 };
+
+namespace {
+
+// The pixels `vertices` project to in a camera-size image, a pixel wider on each side; the whole
+// image when one is behind the near plane.
+Compositor::Rect ProjectedRect(const std::vector<glm::vec3>& vertices, const glm::mat4& clip_from_world, int width,
+                               int height) {
+  if (vertices.empty()) return {};
+  glm::vec2 lo(1e30f), hi(-1e30f);
+  for (const glm::vec3& p : vertices) {
+    const glm::vec4 c = clip_from_world * glm::vec4(p, 1.0f);
+    if (c.w < kNear) return {0, 0, width, height};
+    // Window coordinates, then image rows from the top.
+    const glm::vec2 window(0.5f * (c.x / c.w + 1.0f) * static_cast<float>(width),
+                           0.5f * (c.y / c.w + 1.0f) * static_cast<float>(height));
+    const glm::vec2 image(window.x, static_cast<float>(height) - window.y);
+    lo = glm::min(lo, image), hi = glm::max(hi, image);
+  }
+  const int x0 = std::clamp(static_cast<int>(std::floor(lo.x)) - 1, 0, width);
+  const int y0 = std::clamp(static_cast<int>(std::floor(lo.y)) - 1, 0, height);
+  const int x1 = std::clamp(static_cast<int>(std::ceil(hi.x)) + 1, 0, width);
+  const int y1 = std::clamp(static_cast<int>(std::ceil(hi.y)) + 1, 0, height);
+  if (x1 <= x0 || y1 <= y0) return {};
+  return {x0, y0, x1 - x0, y1 - y0};
+}
+
+}  // namespace
 
 Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& options) : gl_(std::make_unique<Gl>()) {
   Gl& g = *gl_;
   g.options = options;
   g.width = scene.intrinsics.width, g.height = scene.intrinsics.height;
-  g.clip_from_world = ClipFromCamera(scene.intrinsics, kNear, kFar) * CameraFromWorld(scene.cam_from_world);
-  if (scene.volume) g.volume = *scene.volume;  // else the volume textures stay unused (input.volume must be null)
+  const glm::mat4 camera_from_world = CameraFromWorld(scene.cam_from_world);
   // The real model, for depth only.
   std::vector<uint32_t> indices;
   for (const scene::Triangle& t : scene.model.triangles) indices.insert(indices.end(), {t.v[0], t.v[1], t.v[2]});
   g.model = Upload(scene.model.vertices, nullptr, indices);
   scene.model.Bounds(&g.model_lo, &g.model_hi);
+  std::vector<glm::vec3> all_vertices;
   for (const scene::VirtualObject& o : scene.objects) {
     const scene::Mesh mesh = scene::ObjectMesh(o);
     g.objects.push_back(Upload(mesh.positions, &mesh.normals, mesh.indices));
     g.objects.back().albedo = glm::vec3(o.albedo.value_or(glm::dvec3(0.5)));
     for (const glm::vec3& p : mesh.positions) g.objects_lo = glm::min(g.objects_lo, p), g.objects_hi = glm::max(g.objects_hi, p);
+    all_vertices.insert(all_vertices.end(), mesh.positions.begin(), mesh.positions.end());
   }
+  // The rectangle: the camera with its principal point moved to the rectangle's corner.
+  g.rect = ProjectedRect(all_vertices, ClipFromCamera(scene.intrinsics, kNear, kFar) * camera_from_world, g.width, g.height);
+  scene::CameraIntrinsics k = scene.intrinsics;
+  k.cx -= g.rect.x, k.cy -= g.rect.y;
+  k.width = std::max(g.rect.width, 1), k.height = std::max(g.rect.height, 1);
+  g.clip_from_world = ClipFromCamera(k, kNear, kFar) * camera_from_world;
+  const int rw = k.width, rh = k.height;
   // Framebuffers: 4× MSAA float colour + depth, resolved into single-sample float.
   glBindRenderbuffer(GL_RENDERBUFFER, g.msaa_color.get());
-  glRenderbufferStorageMultisample(GL_RENDERBUFFER, options.samples, GL_RGBA32F, g.width, g.height);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, options.samples, GL_RGBA32F, rw, rh);
   glBindRenderbuffer(GL_RENDERBUFFER, g.msaa_depth.get());
-  glRenderbufferStorageMultisample(GL_RENDERBUFFER, options.samples, GL_DEPTH_COMPONENT24, g.width, g.height);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, options.samples, GL_DEPTH_COMPONENT24, rw, rh);
   glBindFramebuffer(GL_FRAMEBUFFER, g.msaa.get());
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, g.msaa_color.get());
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, g.msaa_depth.get());
   if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) ThrowInputError("OpenGL: no {}× MSAA float framebuffer", options.samples);
   glBindRenderbuffer(GL_RENDERBUFFER, g.resolved_color.get());
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, g.width, g.height);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, rw, rh);
   glBindFramebuffer(GL_FRAMEBUFFER, g.resolved.get());
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, g.resolved_color.get());
   // The sun's shadow map: depth with hardware comparison.
@@ -235,17 +313,9 @@ Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& optio
   glDrawBuffer(GL_NONE);
   glReadBuffer(GL_NONE);
   glBindTexture(GL_TEXTURE_2D, g.background_texture.get());
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, g.width, g.height, 0, GL_RGB, GL_FLOAT, nullptr);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, rw, rh, 0, GL_RGB, GL_FLOAT, nullptr);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  const glm::ivec3 n = g.volume.resolution;
-  for (const GlTexture& t : g.sh) {
-    glBindTexture(GL_TEXTURE_3D, t.get());
-    glTexImage3D(GL_TEXTURE_3D, 0, GL_RGB32F, n.x, n.y, n.z, 0, GL_RGB, GL_FLOAT, nullptr);
-    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    for (const GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTexParameteri(GL_TEXTURE_3D, wrap, GL_CLAMP_TO_EDGE);
-  }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   if (glGetError() != GL_NO_ERROR) ThrowInputError("OpenGL: setting up the compositor failed");
 }
@@ -268,17 +338,20 @@ void Compositor::SetObjectLosses(const std::vector<glm::vec3>& sun_loss, const s
 }
 
 int Compositor::width() const { return gl_->width; }
+const Compositor::Rect& Compositor::objects_rect() const { return gl_->rect; }
 int Compositor::height() const { return gl_->height; }
 
-void Compositor::Render(const CompositeInput& input, std::vector<float>* out) {
+void Compositor::Render(const CompositeInput& input, float* image) {
   Gl& g = *gl_;
+  const Rect& r = g.rect;
+  if (r.width == 0) return;  // no objects in view
   const glm::vec3 sun = glm::normalize(input.sun_dir);
+  const bool sun_up = sun.z > 0.0f;
   // The sun's view: orthographic, its width over the objects' bounds, its depth over everything
-  // that can stand between them and the sun.
-  glm::mat4 shadow_from_world(1.0f);
-  float shadow_texel = 0.0f;
-  const bool sun_up = sun.z > 0.0f && !g.objects.empty();
-  if (sun_up) {
+  // that can stand between them and the sun. Redrawn when the sun has moved more than 0.05°.
+  if (sun_up && (!g.has_shadow_map || glm::dot(sun, g.shadow_sun) < std::cos(glm::radians(0.05f)))) {
+    g.has_shadow_map = true;
+    g.shadow_sun = sun;
     const glm::vec3 centre = 0.5f * (g.objects_lo + g.objects_hi);
     const float radius = 0.5f * glm::length(g.objects_hi - g.objects_lo) + 0.05f;
     float reach = radius;
@@ -289,8 +362,8 @@ void Compositor::Render(const CompositeInput& input, std::vector<float>* out) {
     }
     const glm::vec3 up = std::abs(sun.z) < 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
     const glm::mat4 view = glm::lookAt(centre + (reach + 1.0f) * sun, centre, up);
-    shadow_from_world = glm::ortho(-radius, radius, -radius, radius, 0.0f, reach + radius + 2.0f) * view;
-    shadow_texel = 2.0f * radius / static_cast<float>(g.options.shadow_map_size);
+    g.shadow_from_world = glm::ortho(-radius, radius, -radius, radius, 0.0f, reach + radius + 2.0f) * view;
+    g.shadow_texel = 2.0f * radius / static_cast<float>(g.options.shadow_map_size);
     glBindFramebuffer(GL_FRAMEBUFFER, g.shadow.get());
     glViewport(0, 0, g.options.shadow_map_size, g.options.shadow_map_size);
     glEnable(GL_DEPTH_TEST);
@@ -299,37 +372,51 @@ void Compositor::Render(const CompositeInput& input, std::vector<float>* out) {
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(2.0f, 4.0f);
     glUseProgram(g.depth.id());
-    glUniformMatrix4fv(g.depth.Uniform("clip_from_world"), 1, GL_FALSE, glm::value_ptr(shadow_from_world));
+    glUniformMatrix4fv(g.depth.Uniform("clip_from_world"), 1, GL_FALSE, glm::value_ptr(g.shadow_from_world));
     Draw(g.model);
     for (const DrawMesh& m : g.objects) Draw(m);
     glDisable(GL_POLYGON_OFFSET_FILL);
   }
-  // The volume's coefficients, one 3D texture each.
-  const bool has_volume = input.volume != nullptr && !input.volume->empty();
+  // The volume's coefficients at every object vertex (trilinear, the corners found once).
+  const bool has_volume = input.volume != nullptr;
   if (has_volume) {
-    const glm::ivec3 n = g.volume.resolution;
-    const size_t probes = static_cast<size_t>(n.x) * n.y * n.z;
-    g.plane.resize(probes * 3);
-    for (int c = 0; c < 9; ++c) {
-      for (size_t p = 0; p < probes; ++p) {
-        for (int k = 0; k < 3; ++k) g.plane[p * 3 + k] = (*input.volume)[(p * 9 + static_cast<size_t>(c)) * 3 + k];
+    const std::vector<float>& coefficients = input.volume->coefficients();
+    for (DrawMesh& m : g.objects) {
+      if (m.corner_probes.empty()) {
+        m.corner_probes.resize(m.vertices), m.corner_weights.resize(m.vertices);
+        for (size_t v = 0; v < m.vertices; ++v) input.volume->Corners(m.world[v], &m.corner_probes[v], &m.corner_weights[v]);
       }
-      glBindTexture(GL_TEXTURE_3D, g.sh[c].get());
-      glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, n.x, n.y, n.z, GL_RGB, GL_FLOAT, g.plane.data());
+      g.vertex_sh.assign(m.vertices * 27, 0.0f);
+      for (size_t v = 0; v < m.vertices; ++v) {
+        float* out = &g.vertex_sh[v * 27];
+        for (size_t corner = 0; corner < 8; ++corner) {
+          const float w = m.corner_weights[v][corner];
+          if (w == 0.0f) continue;
+          const float* in = &coefficients[m.corner_probes[v][corner] * 27];
+          for (int k = 0; k < 27; ++k) out[k] += w * in[k];
+        }
+      }
+      glBindBuffer(GL_ARRAY_BUFFER, m.sh.get());
+      glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(g.vertex_sh.size() * sizeof(float)), g.vertex_sh.data());
     }
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
   }
   // Background, phantom, objects.
   glBindFramebuffer(GL_FRAMEBUFFER, g.msaa.get());
-  glViewport(0, 0, g.width, g.height);
+  glViewport(0, 0, r.width, r.height);
   glClear(GL_DEPTH_BUFFER_BIT);
   glDisable(GL_DEPTH_TEST);
   glDepthMask(GL_FALSE);
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, g.background_texture.get());
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, g.width, g.height, GL_RGB, GL_FLOAT, input.background);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, g.width);
+  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, r.width, r.height, GL_RGB, GL_FLOAT,
+                  image + (static_cast<size_t>(r.y) * g.width + r.x) * 3);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
   glUseProgram(g.background.id());
   glUniform1i(g.background.Uniform("background"), 0);
-  glUniform1i(g.background.Uniform("height"), g.height);
+  glUniform1i(g.background.Uniform("height"), r.height);
   glBindVertexArray(g.empty_vao.get());
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glEnable(GL_DEPTH_TEST);
@@ -342,43 +429,37 @@ void Compositor::Render(const CompositeInput& input, std::vector<float>* out) {
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glUseProgram(g.object.id());
   glUniformMatrix4fv(g.object.Uniform("clip_from_world"), 1, GL_FALSE, glm::value_ptr(g.clip_from_world));
-  glUniformMatrix4fv(g.object.Uniform("shadow_from_world"), 1, GL_FALSE, glm::value_ptr(shadow_from_world));
+  glUniformMatrix4fv(g.object.Uniform("shadow_from_world"), 1, GL_FALSE, glm::value_ptr(g.shadow_from_world));
   glUniform3fv(g.object.Uniform("sun_dir"), 1, glm::value_ptr(sun));
   const glm::vec3 sun_rgb = sun_up ? glm::vec3(input.light.sun_rgb) : glm::vec3(0.0f);
   glUniform3fv(g.object.Uniform("sun_rgb"), 1, glm::value_ptr(sun_rgb));
   const glm::vec3 sky_rgb(input.light.sky_rgb);
   glUniform3fv(g.object.Uniform("sky_rgb"), 1, glm::value_ptr(sky_rgb));
-  glUniform1f(g.object.Uniform("shadow_texel"), shadow_texel);
+  glUniform1f(g.object.Uniform("shadow_texel"), g.shadow_texel);
   glActiveTexture(GL_TEXTURE1);
   glBindTexture(GL_TEXTURE_2D, g.shadow_map.get());
   glUniform1i(g.object.Uniform("shadow_map"), 1);
   glUniform1i(g.object.Uniform("has_volume"), has_volume ? 1 : 0);
-  glUniform3fv(g.object.Uniform("volume_min"), 1, glm::value_ptr(glm::vec3(g.volume.min)));
-  glUniform3fv(g.object.Uniform("volume_max"), 1, glm::value_ptr(glm::vec3(g.volume.max)));
-  glUniform3fv(g.object.Uniform("volume_n"), 1, glm::value_ptr(glm::vec3(g.volume.resolution)));
-  for (int c = 0; c < 9; ++c) {
-    glActiveTexture(static_cast<GLenum>(GL_TEXTURE2 + c));
-    glBindTexture(GL_TEXTURE_3D, g.sh[c].get());
-    const std::string name = "sh" + std::to_string(c);
-    glUniform1i(g.object.Uniform(name.c_str()), 2 + c);
-  }
   for (const DrawMesh& m : g.objects) {
+    // A closed mesh's back faces are hidden by its front ones: not drawing them halves the work.
+    if (m.closed) glEnable(GL_CULL_FACE);
     glUniform3fv(g.object.Uniform("albedo"), 1, glm::value_ptr(m.albedo));
     Draw(m);
+    glDisable(GL_CULL_FACE);
   }
   glBindVertexArray(0);
-  // Resolve and read back, top row first.
+  // Resolve, and read back into the image's rectangle, top row first.
   glBindFramebuffer(GL_READ_FRAMEBUFFER, g.msaa.get());
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g.resolved.get());
-  glBlitFramebuffer(0, 0, g.width, g.height, 0, 0, g.width, g.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBlitFramebuffer(0, 0, r.width, r.height, 0, 0, r.width, r.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, g.resolved.get());
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  out->resize(static_cast<size_t>(g.width) * g.height * 3);
-  g.readback.resize(out->size());
-  glReadPixels(0, 0, g.width, g.height, GL_RGB, GL_FLOAT, g.readback.data());
-  const size_t row = static_cast<size_t>(g.width) * 3;
-  for (int y = 0; y < g.height; ++y) {
-    std::copy_n(g.readback.data() + static_cast<size_t>(g.height - 1 - y) * row, row, out->data() + static_cast<size_t>(y) * row);
+  const size_t row = static_cast<size_t>(r.width) * 3;
+  g.readback.resize(row * static_cast<size_t>(r.height));
+  glReadPixels(0, 0, r.width, r.height, GL_RGB, GL_FLOAT, g.readback.data());
+  for (int y = 0; y < r.height; ++y) {
+    std::copy_n(g.readback.data() + static_cast<size_t>(r.height - 1 - y) * row, row,
+                image + (static_cast<size_t>(r.y + y) * g.width + r.x) * 3);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }

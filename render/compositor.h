@@ -5,8 +5,12 @@
 //   - the real model is drawn into depth only, a phantom, so real walls hide objects behind them;
 //   - each object fragment is L = ρ/π (E_sun·v·max(0, n·l) + E_volume(p, n)): v from a sun shadow
 //     map of the real model and the objects (so real walls shade objects, and objects each other
-//     and themselves), E_volume the SH9 irradiance volume, trilinear per fragment;
+//     and themselves), E_volume the SH9 irradiance volume: its coefficients trilinear at the
+//     vertices, interpolated across each triangle, evaluated with the fragment's normal;
 //   - 4× MSAA in RGBA32F, resolved and read back as linear floats.
+// Only the rectangle the objects project to is drawn, uploaded and read back (the rest of the
+// frame is the background as it was), and the sun's shadow map is redrawn only when the sun has
+// moved more than 0.05°.
 // Needs a current GL 3.3 core context (render/gl_context.h).
 #pragma once
 
@@ -16,15 +20,15 @@
 #include <glm/glm.hpp>
 
 #include "estimation/lighting_model.h"
+#include "relight/irradiance_volume.h"
 #include "scene/scene.h"
 
 namespace daylit::render {
 
 struct CompositeInput {
-  const float* background = nullptr;  // camera-size linear RGB, row-major from the top row
   estimation::SunSky light;           // E_sun (DNI) and E_sky, radiance units
   glm::vec3 sun_dir{0.0f, 0.0f, 1.0f};  // unit, toward the sun, scene coordinates
-  const std::vector<float>* volume = nullptr;  // IrradianceVolume::coefficients(); null: no indirect light
+  const relight::IrradianceVolume* volume = nullptr;  // updated for this frame; always the same one; null: no indirect light
 };
 
 struct CompositorOptions {
@@ -46,8 +50,16 @@ class Compositor {
   // scene::ObjectMesh order (relight::ObjectBounce); applied with the volume's light.
   void SetObjectLosses(const std::vector<glm::vec3>& sun_loss, const std::vector<glm::vec3>& sky_loss);
 
-  // Renders one frame; `out` receives camera-size linear RGB, row-major from the top row.
-  void Render(const CompositeInput& input, std::vector<float>* out);
+  // Draws the objects into `image`: camera-size linear RGB, row-major from the top row, holding
+  // the background (the frame with the objects' shadows applied).
+  void Render(const CompositeInput& input, float* image);
+
+  // The pixels the objects can cover (x, y of the top-left corner, width, height; empty without
+  // objects): their projection, a pixel wider. Pixels outside it are never changed.
+  struct Rect {
+    int x = 0, y = 0, width = 0, height = 0;
+  };
+  const Rect& objects_rect() const;
 
  private:
   struct Gl;

@@ -41,11 +41,11 @@ struct Fixture {
     s.objects = objects;
     Compositor compositor(s);
     CompositeInput in;
-    in.background = background.data();
     in.light.sun_rgb = glm::dvec3(10.0, 20.0, 30.0);
     in.sun_dir = sun;
     std::vector<float> out;
-    compositor.Render(in, &out);
+    out = background;
+    compositor.Render(in, out.data());
     return out;
   }
 

@@ -21,36 +21,46 @@ FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& b
   }
 }
 
-void FrameRenderer::Render(const capture::Frame& frame, const estimation::SunSky& light, double overcast_share,
-                           const glm::vec3& sun_dir, std::vector<float>* out) {
+void FrameRenderer::Linearize(const capture::Frame& frame, std::vector<float>* linear) const {
   if (frame.rgb.cols != width() || frame.rgb.rows != height() || frame.rgb.type() != CV_32FC3) {
     ThrowInputError("frame {}: {}x{}, not the camera's {}x{}", frame.index, frame.rgb.cols, frame.rgb.rows, width(), height());
   }
-  // Linear radiance: the response's inverse, then the exposure divided out.
+  // The response's inverse, then the exposure divided out.
   const size_t n = static_cast<size_t>(width()) * height() * 3;
-  linear_.resize(n);
+  linear->resize(n);
   const float scale = static_cast<float>(1.0 / frame.exposure);
   const float* in = frame.rgb.ptr<float>();
+  float* out = linear->data();
   if (frame.linear) {
-    for (size_t i = 0; i < n; ++i) linear_[i] = in[i] * scale;
-  } else {
-    for (size_t i = 0; i < n; ++i) linear_[i] = linearizer_(in[i], static_cast<int>(i % 3)) * scale;
+    for (size_t i = 0; i < n; ++i) out[i] = in[i] * scale;
+    return;
   }
+  for (size_t i = 0; i < n; i += 3) {
+    out[i] = linearizer_(in[i], 0) * scale;
+    out[i + 1] = linearizer_(in[i + 1], 1) * scale;
+    out[i + 2] = linearizer_(in[i + 2], 2) * scale;
+  }
+}
+
+void FrameRenderer::Render(const capture::Frame& frame, const estimation::SunSky& light, double overcast_share,
+                           const glm::vec3& sun_dir, std::vector<float>* out) {
+  Linearize(frame, out);
   CompositeInput input;
   input.light = light;
   input.sun_dir = sun_dir;
   if (volume_) {
     if (bounce_.SetSun(sun_dir)) compositor_.SetObjectLosses(bounce_.sun_loss(), bounce_.sky_loss());
-    relighter_.SetSun(sun_dir);
+    if (relighter_.SetSun(sun_dir)) {
+      relighter_.Basis(&basis_);
+      shadows_.SetEnvBasis(basis_);
+    }
     relighter_.Relight(light, overcast_share, &env_);
     volume_->Update(env_);
-    input.volume = &volume_->coefficients();
+    input.volume = volume_.get();
   }
-  background_ = linear_;
   shadows_.SetSun(sun_dir);
-  shadows_.Apply(light, volume_ ? &env_ : nullptr, background_.data());
-  input.background = background_.data();
-  compositor_.Render(input, out);
+  shadows_.Apply(light, overcast_share, out->data());
+  compositor_.Render(input, out->data());
 }
 
 }  // namespace daylit::render

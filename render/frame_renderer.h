@@ -31,8 +31,8 @@ class FrameRenderer {
   void Render(const capture::Frame& frame, const estimation::SunSky& light, double overcast_share,
               const glm::vec3& sun_dir, std::vector<float>* out);
 
-  // The frame linearised in radiance units, before the objects and their shadows.
-  const std::vector<float>& linear_frame() const { return linear_; }
+  // The frame linearised in radiance units, as Render starts from (for comparisons).
+  void Linearize(const capture::Frame& frame, std::vector<float>* linear) const;
   const relight::ObjectShadows& shadows() const { return shadows_; }
   int width() const { return compositor_.width(); }
   int height() const { return compositor_.height(); }
@@ -48,8 +48,8 @@ class FrameRenderer {
   std::unique_ptr<relight::IrradianceVolume> volume_;
   Compositor compositor_;
   capture::Linearizer linearizer_;
-  std::vector<float> linear_, background_;
   std::vector<glm::vec3> env_;
+  relight::EnvBasis basis_;
 };
 
 }  // namespace daylit::render

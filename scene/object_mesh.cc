@@ -15,8 +15,11 @@ Mesh SphereMesh(float radius, int stacks, int slices) {
   for (int i = 0; i <= stacks; ++i) {
     const float theta = glm::pi<float>() * static_cast<float>(i) / static_cast<float>(stacks);
     for (int j = 0; j <= slices; ++j) {
-      const float phi = 2.0f * glm::pi<float>() * static_cast<float>(j) / static_cast<float>(slices);
-      const glm::vec3 n(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+      // The seam's and the poles' copies of a vertex are exactly equal: the mesh is watertight.
+      const float phi = 2.0f * glm::pi<float>() * static_cast<float>(j % slices) / static_cast<float>(slices);
+      const float sin_theta = i == 0 || i == stacks ? 0.0f : std::sin(theta);
+      const float cos_theta = i == 0 ? 1.0f : i == stacks ? -1.0f : std::cos(theta);
+      const glm::vec3 n(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta);
       mesh.positions.push_back(radius * n);
       mesh.normals.push_back(n);
     }

@@ -6,9 +6,13 @@
 #   sun.png   the sun's elevation and azimuth over the recording
 #   bake/     the offline scene maps (env-map and camera albedo, sky visibility, gather tables,
 #             albedo.csv, PNG previews); re-used while the recording is unchanged
-#   estimates.csv, lighting.png, lighting.txt
-#             the sun and sky per frame, their plot, and (with ground truth) the median errors
-# Later parts of the pipeline (relighting, rendering) join this job as they land.
+#   replay.mp4  the augmented video: every frame with the scene's virtual objects, lit by that
+#             frame's estimate and shadowed both ways (daylit replay)
+#   estimates.csv, lighting.png
+#             the sun and sky per frame and their plot
+#   report.txt  speed, and with ground truth the lighting's errors and the composite's fidelity
+#   fidelity.csv, fidelity.png, worst_vs_truth.png
+#             with ground truth: per truth frame, the composite against the path tracer's
 set -euo pipefail
 cd "$(dirname "$0")/.."
 recording=${1:-recordings/courtyard-a}
@@ -23,7 +27,5 @@ mv "$out/info.txt.tmp" "$out/info.txt"
 "$daylit" bake "$recording" --cache "$out/bake" >/dev/null
 echo "albedo per surface (from the env map):"
 cat "$out/bake/albedo.csv"
-"$daylit" estimate "$recording" --cache "$out/bake" --out "$out/estimates.csv" --plot "$out/lighting.png" \
-  | tee "$out/lighting.txt.tmp"
-mv "$out/lighting.txt.tmp" "$out/lighting.txt"
+"$daylit" replay "$recording" --cache "$out/bake" --out "$out/replay.mp4"
 echo "results in $out/"

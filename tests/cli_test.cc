@@ -13,9 +13,11 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "bake/synthetic_recording.h"
 #include "capture/response.h"
+#include "capture/video_decoder.h"
 #include "base/atomic_file.h"
 #include "base/csv.h"
 #include "relight/exact_irradiance.h"
@@ -57,7 +59,7 @@ const std::string kRecording = DAYLIT_SOURCE_DIR "/recordings/courtyard-a";
 const std::string kProbe = DAYLIT_SOURCE_DIR "/probes/stpeters_latlong_1024x512.hdr";
 
 TEST(CliTest, HelpForEverySubcommand) {
-  for (const char* sub : {"", "sunpos ", "info ", "lights ", "record ", "render ", "calibrate-response ", "calibrate-camera "}) {
+  for (const char* sub : {"", "sunpos ", "info ", "lights ", "record ", "render ", "replay ", "calibrate-response ", "calibrate-camera "}) {
     const CliRun run = Daylit(std::string(sub) + "--help");
     EXPECT_EQ(run.exit_code, 0) << sub;
     EXPECT_NE(run.out.find("Usage"), std::string::npos) << sub << run.out;
@@ -377,6 +379,69 @@ TEST(CliTest, RenderWritesTheCompositeAndComparesItWithTheTruth) {
   fs::remove_all(dir);
 }
 
+// The main job on the first 60 frames (two of them with the path tracer's truth): the video has
+// every frame, the objects are in it where the truth's mask says and nowhere else changes more
+// than the H.264 round trip does; the CSV, plots and report are beside it, nothing half-written.
+TEST(CliTest, ReplayWritesTheAugmentedVideoAndItsReport) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_replay_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string cache = std::string(DAYLIT_BINARY_DIR) + "/test-cache/courtyard-a";
+  const CliRun run = Daylit("replay " + kRecording + " --frames 60 --cache " + cache + " --out " + (dir / "r.mp4").string(),
+                            kGlEnvironment);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("60 frames in"), std::string::npos) << run.out;
+  EXPECT_NE(run.err.find("replay 100%"), std::string::npos) << "progress";
+  for (const char* name : {"r.mp4", "estimates.csv", "lighting.png", "report.txt", "fidelity.csv", "fidelity.png", "worst_vs_truth.png"}) {
+    EXPECT_TRUE(fs::is_regular_file(dir / name)) << name;
+  }
+  size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) files += entry.is_regular_file() ? 1 : 0;
+  EXPECT_EQ(files, 7u) << "a temporary file was left behind";
+  EXPECT_EQ(ReadCsvFile(dir / "estimates.csv").rows.size(), 60u);
+  // Frames 40 and 50 against the truth: the bar is 10% on the objects and their shadows.
+  const CsvTable fidelity = ReadCsvFile(dir / "fidelity.csv");
+  ASSERT_EQ(fidelity.rows.size(), 2u);
+  for (const auto& row : fidelity.rows) {
+    EXPECT_LT(std::stod(row[static_cast<size_t>(fidelity.RequireColumn("object_error"))]), 0.10) << row[0];
+    EXPECT_LT(std::stod(row[static_cast<size_t>(fidelity.RequireColumn("shadow_error"))]), 0.10) << row[0];
+  }
+  // The video against the recording, frame 40: the objects' pixels changed, the far wall not.
+  capture::VideoDecoder replay(dir / "r.mp4"), original(kRecording + "/video.mp4");
+  cv::Mat a, b;
+  int frames = 0;
+  double object_change = 0.0, wall_change = 0.0;
+  while (replay.Next(&a)) {
+    ASSERT_TRUE(original.Next(&b));
+    if (frames++ != 40) continue;
+    const cv::Mat mask = cv::imread(kRecording + "/groundtruth/objects_mask/000040.png", cv::IMREAD_GRAYSCALE);
+    cv::Mat difference;
+    cv::absdiff(a, b, difference);
+    cv::cvtColor(difference, difference, cv::COLOR_RGB2GRAY);
+    object_change = 255.0 * cv::mean(difference, mask >= 128)[0];
+    wall_change = 255.0 * cv::mean(difference(cv::Rect(100, 20, 760, 100)))[0];
+  }
+  EXPECT_EQ(frames, 60);
+  EXPECT_EQ(replay.width(), 960);
+  EXPECT_GT(object_change, 10.0) << "the objects are not in the video";
+  EXPECT_LT(wall_change, 1.5) << "codes; pixels no object reaches changed";
+  fs::remove_all(dir);
+}
+
+TEST(CliTest, ReplayAndRenderWithoutOpenGlSayWhy) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_nogl_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  // libglvnd finds no EGL vendor: as on a machine without libegl-mesa0 or a GPU driver.
+  const std::string no_egl = kGlEnvironment + "__EGL_VENDOR_LIBRARY_DIRS=/nonexistent ";
+  for (const std::string& args : {"replay " + kRecording + " --frames 5 --out " + (dir / "r.mp4").string(),
+                                  "render " + kRecording + " --frame 5 --out " + (dir / "f.png").string()}) {
+    const CliRun run = Daylit(args, no_egl);
+    EXPECT_EQ(run.exit_code, 2) << args;
+    EXPECT_NE(run.err.find("OpenGL: no EGL display"), std::string::npos) << run.err;
+  }
+  EXPECT_TRUE(fs::is_empty(dir)) << "an output was left behind";
+  fs::remove_all(dir);
+}
+
 TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
   scene::testing::SceneSandbox sandbox("cli");
   sandbox.WriteText("broken.json", "{\"format\": \"daylit-recording/1\",");
@@ -420,6 +485,10 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
        "--exposure-100us: Value -5 not in range 1 to 1000000"},
       {"render " + kRecording + " --frame 300 --out " + dir + "/frame.jpg", "--out: " + dir + "/frame.jpg must end in .png or .exr"},
       {"render " + kRecording + " --frame 99999 --out " + dir + "/frame.png", "--frame: 99999 is not in"},
+      {"replay " + kRecording + " --out " + dir + "/r.avi", "--out: " + dir + "/r.avi must end in .mp4 or .mkv"},
+      {"replay " + kRecording + " --out " + dir + "/no/such/r.mp4", "--out: " + dir + "/no/such: no such folder"},
+      {"replay " + kRecording + " --out /proc/r.mp4", "--out: cannot write /proc/r.mp4"},
+      {"replay " + kRecording + " --frames 0", "--frames: 0 is not a number of frames"},
   };
   for (const BadCall& call : calls) {
     const CliRun run = Daylit(call.args);  // NOLINT

@@ -41,7 +41,7 @@ TEST(ObjectShadowsRecordingTest, ShadowsAndSkyLossMatchThePathTracer) {
   const scene::RayCaster objects(objects_model);
   ObjectShadows shadows(scene, c.bake, real, objects);
   EnvRelighter relighter(c.bake, glm::vec3(scene.envmap->position), real);
-  std::vector<glm::vec3> env;
+  EnvBasis basis;
   std::printf("sky loss on %zu pixels\n", shadows.SkyLossPixels());
   const CsvTable truth_csv = ReadCsvFile(*scene.groundtruth.lighting);
   std::map<int, estimation::SunSky> truth_light;
@@ -71,9 +71,11 @@ TEST(ObjectShadowsRecordingTest, ShadowsAndSkyLossMatchThePathTracer) {
     const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(time, scene.location, atmosphere, {});
     const glm::vec3 sun_dir(scene.GeoFrame().DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg));
     shadows.SetSun(sun_dir);
-    relighter.SetSun(sun_dir);
-    relighter.Relight(truth_light.at(index), overcast, &env);
-    shadows.Apply(truth_light.at(index), &env, predicted.rgb.data());
+    if (relighter.SetSun(sun_dir)) {
+      relighter.Basis(&basis);
+      shadows.SetEnvBasis(basis);
+    }
+    shadows.Apply(truth_light.at(index), overcast, predicted.rgb.data());
     ShadowFidelity f;
     size_t changed = 0;
     for (size_t p = 0; p < with.rgb.size() / 3; ++p) {

@@ -43,7 +43,9 @@ TEST(RenderRecordingTest, CompositesMatchThePathTracedFramesWithObjects) {
     const scene::HdrImage with = scene::ReadHdrImage(with_file);
     const scene::HdrImage without = scene::ReadHdrImage(gt / "without_objects" / fmt::format("{:06d}.exr", index));
     const cv::Mat mask = cv::imread((gt / "objects_mask" / fmt::format("{:06d}.png", index)).string(), cv::IMREAD_GRAYSCALE);
-    const CompositeFidelity f = CompareComposite(out, renderer.linear_frame(), with.rgb, without.rgb, mask);
+    std::vector<float> linear;
+    renderer.Linearize(fit.frame, &linear);
+    const CompositeFidelity f = CompareComposite(out, linear, with.rgb, without.rgb, mask);
     const double object_error = f.object_error, shadow_error = f.shadow_error;
     std::printf("frame %3d: objects %.1f%% over %zu pixels, their shadows %.1f%% over %zu pixels (the video itself %.1f%% off the noise-free frame there)\n", index,
                 100 * object_error, f.object_pixels, 100 * shadow_error, f.shadow_pixels, 100 * f.frame_shadow_error);

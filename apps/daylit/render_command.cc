@@ -75,7 +75,9 @@ void RunRender(const RenderOptions& o) {
   if (with.width != w || with.height != h || without.width != w || without.height != h || mask.cols != w || mask.rows != h) {
     ThrowInputError("{}: the truth frames are not {}x{}", gt.string(), w, h);
   }
-  const render::CompositeFidelity f = render::CompareComposite(composite, renderer.linear_frame(), with.rgb, without.rgb, mask);
+  std::vector<float> linear;
+  renderer.Linearize(fit.frame, &linear);
+  const render::CompositeFidelity f = render::CompareComposite(composite, linear, with.rgb, without.rgb, mask);
   fs::path strip = out;
   strip.replace_extension();
   strip += "_vs_truth.png";
