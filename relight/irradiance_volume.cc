@@ -1,5 +1,7 @@
 #include "relight/irradiance_volume.h"
 
+#include "base/error.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -113,6 +115,19 @@ glm::vec3 IrradianceVolume::ProbeIrradiance(int i, int j, int k, const glm::vec3
   const glm::ivec3 n = gather_.resolution;
   const size_t p = (static_cast<size_t>(k) * n.y + j) * n.x + i;
   return glm::max(Evaluate(p, EvalSh9(glm::dvec3(normal))), glm::vec3(0.0f));
+}
+
+void IrradianceVolume::SetCombination(const std::array<const std::vector<float>*, 3>& parts,
+                                      const std::array<glm::vec3, 3>& weights) {
+  for (const std::vector<float>* part : parts) {
+    if (part->size() != coefficients_.size()) ThrowInputError("SetCombination: {} coefficients for a volume of {}", part->size(), coefficients_.size());
+  }
+  for (size_t i = 0; i < coefficients_.size(); i += 3) {
+    for (int k = 0; k < 3; ++k) {
+      const size_t j = i + static_cast<size_t>(k);
+      coefficients_[j] = weights[0][k] * (*parts[0])[j] + weights[1][k] * (*parts[1])[j] + weights[2][k] * (*parts[2])[j];
+    }
+  }
 }
 
 glm::vec3 IrradianceVolume::Irradiance(const glm::vec3& point, const glm::vec3& normal) const {

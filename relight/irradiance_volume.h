@@ -37,6 +37,11 @@ class IrradianceVolume {
   // excluded): the gather directions carry 4π/N sr each.
   void Update(const std::vector<glm::vec3>& env_radiance);
 
+  // Sets the coefficients to Σ_i weights[i] · parts[i], channel by channel, `parts` being
+  // coefficients() after updates from other maps: Update is linear, so this is the update from
+  // the map Σ_i weights[i] · map_i (how the renderer follows each frame's light at no cost).
+  void SetCombination(const std::array<const std::vector<float>*, 3>& parts, const std::array<glm::vec3, 3>& weights);
+
   // Irradiance at `point` (clamped into the volume) on a surface with unit normal `normal`.
   glm::vec3 Irradiance(const glm::vec3& point, const glm::vec3& normal) const;
   // Σ_c coefficient_c(point) · weights_c, the coefficients trilinear at `point` (clamped into the

@@ -88,5 +88,35 @@ TEST(IrradianceVolumeTest, AProbeInsideAWallTakesItsNeighboursValues) {
   EXPECT_GT(want, 2.0f);  // not black
 }
 
+// The renderer's shortcut: the volume of a combination of maps is the combination of their
+// volumes, inside probes included (their neighbours' mean is linear too).
+TEST(IrradianceVolumeTest, CombiningUpdatesEqualsUpdatingTheCombinedMap) {
+  const std::string faces =
+      "o block\n"
+      "v -1.2 -1.2 0.3\nv -0.8 -1.2 0.3\nv -0.8 -0.8 0.3\nv -1.2 -0.8 0.3\n"
+      "v -1.2 -1.2 0.7\nv -0.8 -1.2 0.7\nv -0.8 -0.8 0.7\nv -1.2 -0.8 0.7\n"
+      "f 5 8 7 6\nf 9 10 11 12\nf 5 6 10 9\nf 6 7 11 10\nf 7 8 12 11\nf 8 5 9 12\n";
+  const OpenGround w("volume_combine", faces);
+  IrradianceVolume volume(w.bake.gather, ProbesInsideModel(w.bake.gather, *w.caster));
+  ASSERT_EQ(volume.InsideCount(), 1u);
+  const size_t texels = w.bake.env.radiance.size();
+  std::array<std::vector<glm::vec3>, 3> maps;
+  std::array<std::vector<float>, 3> parts;
+  for (size_t i = 0; i < 3; ++i) {
+    maps[i].resize(texels);
+    for (size_t t = 0; t < texels; ++t) maps[i][t] = glm::vec3(static_cast<float>((t * (i + 3)) % 101) / 101.0f, 0.2f * static_cast<float>(i), 1.0f);
+    volume.Update(maps[i]);
+    parts[i] = volume.coefficients();
+  }
+  const std::array<glm::vec3, 3> weights = {glm::vec3(2.0f, 0.5f, 1.0f), glm::vec3(0.3f, 4.0f, 0.0f), glm::vec3(1.5f)};
+  std::vector<glm::vec3> combined(texels);
+  for (size_t t = 0; t < texels; ++t) combined[t] = weights[0] * maps[0][t] + weights[1] * maps[1][t] + weights[2] * maps[2][t];
+  volume.Update(combined);
+  const std::vector<float> direct = volume.coefficients();
+  volume.SetCombination({&parts[0], &parts[1], &parts[2]}, weights);
+  ASSERT_EQ(volume.coefficients().size(), direct.size());
+  for (size_t i = 0; i < direct.size(); ++i) EXPECT_NEAR(volume.coefficients()[i], direct[i], 1e-4f * (1.0f + std::abs(direct[i]))) << i;
+}
+
 }  // namespace
 }  // namespace daylit::relight

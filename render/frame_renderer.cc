@@ -1,5 +1,9 @@
 #include "render/frame_renderer.h"
 
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
 #include "base/error.h"
 #include "scene/object_mesh.h"
 
@@ -35,11 +39,13 @@ void FrameRenderer::Linearize(const capture::Frame& frame, std::vector<float>* l
     for (size_t i = 0; i < n; ++i) out[i] = in[i] * scale;
     return;
   }
-  for (size_t i = 0; i < n; i += 3) {
-    out[i] = linearizer_(in[i], 0) * scale;
-    out[i + 1] = linearizer_(in[i + 1], 1) * scale;
-    out[i + 2] = linearizer_(in[i + 2], 2) * scale;
-  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n / 3, 16384), [&](const tbb::blocked_range<size_t>& pixels) {
+    for (size_t i = 3 * pixels.begin(); i < 3 * pixels.end(); i += 3) {
+      out[i] = linearizer_(in[i], 0) * scale;
+      out[i + 1] = linearizer_(in[i + 1], 1) * scale;
+      out[i + 2] = linearizer_(in[i + 2], 2) * scale;
+    }
+  });
 }
 
 void FrameRenderer::Render(const capture::Frame& frame, const estimation::SunSky& light, double overcast_share,
@@ -50,12 +56,20 @@ void FrameRenderer::Render(const capture::Frame& frame, const estimation::SunSky
   input.sun_dir = sun_dir;
   if (volume_) {
     if (bounce_.SetSun(sun_dir)) compositor_.SetObjectLosses(bounce_.sun_loss(), bounce_.sky_loss());
+    // The relit map is linear in E_sun, E_clear and E_overcast, and so is the volume: the three
+    // parts are recomputed when the sun moves, and each frame only combines them.
     if (relighter_.SetSun(sun_dir)) {
       relighter_.Basis(&basis_);
       shadows_.SetEnvBasis(basis_);
+      const std::vector<glm::vec3>* maps[3] = {&basis_.sun, &basis_.clear, &basis_.overcast};
+      for (size_t i = 0; i < 3; ++i) {
+        volume_->Update(*maps[i]);
+        volume_parts_[i] = volume_->coefficients();
+      }
     }
-    relighter_.Relight(light, overcast_share, &env_);
-    volume_->Update(env_);
+    const float o = static_cast<float>(std::clamp(overcast_share, 0.0, 1.0));
+    const glm::vec3 sun(light.sun_rgb), sky(light.sky_rgb);
+    volume_->SetCombination({&volume_parts_[0], &volume_parts_[1], &volume_parts_[2]}, {sun, (1.0f - o) * sky, o * sky});
     input.volume = volume_.get();
   }
   shadows_.SetSun(sun_dir);

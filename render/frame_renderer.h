@@ -6,6 +6,7 @@
 // context; everything sun-dependent is recomputed only when the sun has moved.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -48,8 +49,8 @@ class FrameRenderer {
   std::unique_ptr<relight::IrradianceVolume> volume_;
   Compositor compositor_;
   capture::Linearizer linearizer_;
-  std::vector<glm::vec3> env_;
   relight::EnvBasis basis_;
+  std::array<std::vector<float>, 3> volume_parts_;  // the volume per unit E_sun, E_clear, E_overcast
 };
 
 }  // namespace daylit::render

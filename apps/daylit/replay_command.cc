@@ -104,6 +104,14 @@ class VideoThread {
     if (thread_.joinable()) thread_.join();
   }
 
+  // A buffer for the next composite: one the thread has encoded (no allocation), else a new one.
+  std::vector<float> TakeBuffer() {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (spare_.empty()) return {};
+    std::vector<float> buffer = std::move(spare_.back());
+    spare_.pop_back();
+    return buffer;
+  }
   // A linear composite in radiance units and its exposure; an empty one repeats the last frame.
   void Write(std::vector<float> composite, double exposure) {
     Push(Item{std::move(composite), static_cast<float>(exposure), false});
@@ -147,6 +155,8 @@ class VideoThread {
           to_video_.Apply(item.composite.data(), item.exposure, encoded.ptr<float>(), item.composite.size());
         }
         encoder_.Write(encoded);
+        const std::lock_guard<std::mutex> lock(mutex_);
+        if (!item.composite.empty()) spare_.push_back(std::move(item.composite));
       } catch (...) {
         {
           const std::lock_guard<std::mutex> lock(mutex_);
@@ -164,6 +174,7 @@ class VideoThread {
   std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<Item> items_;
+  std::vector<std::vector<float>> spare_;  // encoded composites' buffers, for reuse
   bool closing_ = false;
   std::exception_ptr error_;
   std::thread thread_;  // last: starts once the rest is built
@@ -256,6 +267,7 @@ void RunReplay(const ReplayOptions& o) {
       return;
     }
     const Clock::time_point t0 = Clock::now();
+    composite = video->TakeBuffer();
     renderer.Render(frame, row.light, overcast_share, sun_dir, &composite);
     render_ms.push_back(1e3 * std::chrono::duration<double>(Clock::now() - t0).count());
     if (const auto f = truth.Compare(frame, renderer, composite, &truth_frame)) {
