@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <map>
 #include <cmath>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -129,28 +128,6 @@ struct DrawMesh {
   bool closed = false;  // every edge shared by two triangles that traverse it in opposite directions
 };
 
-// Whether the triangles close a volume with outward (counter-clockwise) faces, vertices welded by
-// position: then the faces turned away from the camera are all hidden.
-bool IsClosed(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices) {
-  std::map<std::array<float, 3>, uint32_t> weld;
-  std::vector<uint32_t> id(positions.size());
-  for (size_t v = 0; v < positions.size(); ++v) {
-    id[v] = weld.emplace(std::array<float, 3>{positions[v].x, positions[v].y, positions[v].z}, static_cast<uint32_t>(weld.size())).first->second;
-  }
-  std::map<std::pair<uint32_t, uint32_t>, int> edges;  // directed edge → count
-  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
-    const uint32_t a = id[indices[t]], b = id[indices[t + 1]], c = id[indices[t + 2]];
-    if (a == b || b == c || c == a) continue;  // degenerate (a pole's fan)
-    for (const auto& e : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
-      if (++edges[e] > 1) return false;
-    }
-  }
-  for (const auto& [e, count] : edges) {
-    if (edges.find({e.second, e.first}) == edges.end()) return false;
-  }
-  return !edges.empty();
-}
-
 DrawMesh Upload(const std::vector<glm::vec3>& positions, const std::vector<glm::vec3>* normals,
                 const std::vector<uint32_t>& indices) {
   DrawMesh m;
@@ -190,7 +167,7 @@ DrawMesh Upload(const std::vector<glm::vec3>& positions, const std::vector<glm::
                             reinterpret_cast<const void*>(static_cast<uintptr_t>(3 * c * sizeof(float))));
     }
     m.world = positions;
-    m.closed = IsClosed(positions, indices);
+    m.closed = scene::IsClosedMesh(positions, indices);
   }
   m.indices = NewBuffer();
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, m.indices.get());

@@ -1,6 +1,8 @@
 #include "scene/object_mesh.h"
 
+#include <array>
 #include <cmath>
+#include <map>
 
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -35,6 +37,8 @@ Mesh SphereMesh(float radius, int stacks, int slices) {
   return mesh;
 }
 
+constexpr int kBoxGrid = 8;  // quads per face edge
+
 Mesh BoxMesh(const glm::vec3& size) {
   Mesh mesh;
   const glm::vec3 h = 0.5f * size;
@@ -44,15 +48,47 @@ Mesh BoxMesh(const glm::vec3& size) {
       n[axis] = sign;
       const glm::vec3 u = axis == 2 ? glm::vec3(1, 0, 0) : glm::vec3(0, 0, 1);
       const glm::vec3 v = glm::cross(n, u);  // (u, v, n) right-handed: counter-clockwise from outside
+      // Each face a grid of quads, so that what is interpolated across triangles (the volume's
+      // light, the bounce losses) follows the surface; its parameters are exact binary fractions,
+      // so the faces' shared edges have bit-identical vertices (a watertight mesh).
       const auto base = static_cast<uint32_t>(mesh.positions.size());
-      for (const auto& [a, b] : {std::pair{-1.0f, -1.0f}, std::pair{1.0f, -1.0f}, std::pair{1.0f, 1.0f}, std::pair{-1.0f, 1.0f}}) {
-        mesh.positions.push_back(h * (n + a * u + b * v));
-        mesh.normals.push_back(n);
+      const auto at = [&](int i, int j) { return base + static_cast<uint32_t>(j * (kBoxGrid + 1) + i); };
+      for (int j = 0; j <= kBoxGrid; ++j) {
+        for (int i = 0; i <= kBoxGrid; ++i) {
+          const float a = -1.0f + 2.0f * static_cast<float>(i) / kBoxGrid, b = -1.0f + 2.0f * static_cast<float>(j) / kBoxGrid;
+          mesh.positions.push_back(h * (n + a * u + b * v));
+          mesh.normals.push_back(n);
+        }
       }
-      mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+      for (int j = 0; j < kBoxGrid; ++j) {
+        for (int i = 0; i < kBoxGrid; ++i) {
+          mesh.indices.insert(mesh.indices.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
+      }
     }
   }
   return mesh;
+}
+
+bool IsClosedMesh(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices) {
+  std::map<std::array<float, 3>, uint32_t> weld;
+  std::vector<uint32_t> id(positions.size());
+  for (size_t v = 0; v < positions.size(); ++v) {
+    const std::array<float, 3> key{positions[v].x, positions[v].y, positions[v].z};
+    id[v] = weld.emplace(key, static_cast<uint32_t>(weld.size())).first->second;
+  }
+  std::map<std::pair<uint32_t, uint32_t>, int> edges;  // directed edge → how often
+  for (size_t t = 0; t + 2 < indices.size(); t += 3) {
+    const uint32_t a = id[indices[t]], b = id[indices[t + 1]], c = id[indices[t + 2]];
+    if (a == b || b == c || c == a) continue;
+    for (const auto& e : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
+      if (++edges[e] > 1) return false;
+    }
+  }
+  for (const auto& [e, count] : edges) {
+    if (edges.find({e.second, e.first}) == edges.end()) return false;
+  }
+  return !edges.empty();
 }
 
 Mesh ObjectMesh(const VirtualObject& object) {

@@ -21,13 +21,18 @@ struct Mesh {
 
 // A UV sphere of `stacks` × `slices` quads about the origin, normals exact.
 Mesh SphereMesh(float radius, int stacks, int slices);
-// A box of full edge lengths `size` about the origin, flat normals.
+// A box of full edge lengths `size` about the origin, flat normals, each face an 8×8 grid of quads.
 Mesh BoxMesh(const glm::vec3& size);
 
 // The object's mesh placed in the scene: R = Rz·Ry·Rx from rotation_deg, then scale, then the
 // position. OBJ files get per-face normals. Throws InputError naming the file for a mesh that
 // cannot be read or has no triangles.
 Mesh ObjectMesh(const VirtualObject& object);
+
+// Whether the triangles close a volume with consistent counter-clockwise-from-outside faces,
+// vertices welded by exact position: every edge is traversed once each way (triangles with two
+// equal vertices, a pole's fan, are skipped). The renderer culls such a mesh's back faces.
+bool IsClosedMesh(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices);
 
 // All the objects as one triangle model, surface i being object i (for a RayCaster).
 SceneModel ObjectsModel(const std::vector<VirtualObject>& objects);

@@ -27,6 +27,15 @@ TEST(ObjectMeshTest, BuiltinShapesAreClosedOutwardAndTheRightSize) {
   EXPECT_NEAR(Volume(box), 0.24, 1e-6);
   // Flat normals point away from the centre.
   for (size_t i = 0; i < box.positions.size(); ++i) EXPECT_GT(glm::dot(box.normals[i], box.positions[i]), 0.0f);
+  // Watertight, so the renderer may cull their back faces.
+  EXPECT_TRUE(IsClosedMesh(sphere.positions, sphere.indices));
+  EXPECT_TRUE(IsClosedMesh(box.positions, box.indices));
+  // A face missing, or one turned inside out: not closed.
+  std::vector<uint32_t> open_box(box.indices.begin() + 6, box.indices.end());
+  EXPECT_FALSE(IsClosedMesh(box.positions, open_box));
+  std::vector<uint32_t> flipped = box.indices;
+  std::swap(flipped[1], flipped[2]);
+  EXPECT_FALSE(IsClosedMesh(box.positions, flipped));
 }
 
 TEST(ObjectMeshTest, PlacementRotatesThenMoves) {
