@@ -20,6 +20,7 @@ FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& b
       relighter_(bake, scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f), caster),
       compositor_(scene, options),
       linearizer_(scene.response) {
+  scene::CheckObjectsOutsideModel(scene.objects, caster, scene.file.string());
   if (!bake.gather.directions.empty()) {
     volume_ = std::make_unique<relight::IrradianceVolume>(bake.gather, relight::ProbesInsideModel(bake.gather, caster));
   }

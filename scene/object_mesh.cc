@@ -2,10 +2,14 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
+#include <functional>
 #include <map>
 
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <tiny_gltf.h>
 
 #include "base/error.h"
 #include "scene/model.h"
@@ -91,26 +95,143 @@ bool IsClosedMesh(const std::vector<glm::vec3>& positions, const std::vector<uin
   return !edges.empty();
 }
 
+namespace {
+
+// The triangles as drawn, one vertex per corner, with the face's normal (counter-clockwise
+// from outside), as the OBJ and glTF readers give them.
+void AddFlatTriangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, Mesh* mesh) {
+  const glm::vec3 cross = glm::cross(b - a, c - a);
+  const glm::vec3 n = glm::length(cross) > 0.0f ? glm::normalize(cross) : glm::vec3(0, 0, 1);
+  for (const glm::vec3& p : {a, b, c}) {
+    mesh->indices.push_back(static_cast<uint32_t>(mesh->positions.size()));
+    mesh->positions.push_back(p);
+    mesh->normals.push_back(n);
+  }
+}
+
+// An accessor's elements as read through its buffer view: `count` × `size` bytes, `stride` apart.
+const unsigned char* AccessorData(const tinygltf::Model& model, const tinygltf::Accessor& accessor, size_t size,
+                                  size_t* stride, const std::string& where) {
+  if (accessor.sparse.isSparse || accessor.bufferView < 0 || static_cast<size_t>(accessor.bufferView) >= model.bufferViews.size()) {
+    ThrowInputError("{}: an accessor without a plain buffer view (sparse or missing) is not supported", where);
+  }
+  const tinygltf::BufferView& view = model.bufferViews[static_cast<size_t>(accessor.bufferView)];
+  if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model.buffers.size()) ThrowInputError("{}: a buffer view without a buffer", where);
+  const std::vector<unsigned char>& data = model.buffers[static_cast<size_t>(view.buffer)].data;
+  *stride = view.byteStride != 0 ? view.byteStride : size;
+  const size_t begin = view.byteOffset + accessor.byteOffset;
+  if (accessor.count > 0 && begin + (accessor.count - 1) * *stride + size > std::min(data.size(), view.byteOffset + view.byteLength)) {
+    ThrowInputError("{}: an accessor runs past its buffer", where);
+  }
+  return data.data() + begin;
+}
+
+// A glTF 2.0 file's triangles in its default scene, node transforms applied, turned from glTF's
+// +Y up to the scene's +Z up (x, y, z) → (x, −z, y).
+Mesh LoadGltfMesh(const std::filesystem::path& path) {
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  std::string error, warning;
+  const bool ok = path.extension() == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, path.string())
+                                             : loader.LoadASCIIFromFile(&model, &error, &warning, path.string());
+  if (!ok) ThrowInputError("{}: not a glTF 2.0 file ({})", path.string(), error.empty() ? "unreadable" : error.substr(0, error.find('\n')));
+  const std::string where = path.string();
+  Mesh mesh;
+  const glm::dmat4 y_up_to_z_up(1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1);  // columns
+  std::function<void(int, const glm::dmat4&)> visit = [&](int index, const glm::dmat4& parent) {
+    if (index < 0 || static_cast<size_t>(index) >= model.nodes.size()) ThrowInputError("{}: node {} does not exist", where, index);
+    const tinygltf::Node& node = model.nodes[static_cast<size_t>(index)];
+    glm::dmat4 local(1.0);
+    if (node.matrix.size() == 16) {
+      for (int c = 0; c < 4; ++c) {
+        for (int r = 0; r < 4; ++r) local[c][r] = node.matrix[static_cast<size_t>(4 * c + r)];
+      }
+    } else {
+      if (node.translation.size() == 3) local = glm::translate(local, glm::dvec3(node.translation[0], node.translation[1], node.translation[2]));
+      if (node.rotation.size() == 4) local *= glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
+      if (node.scale.size() == 3) local = glm::scale(local, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
+    }
+    const glm::dmat4 world = parent * local;
+    if (node.mesh >= 0) {
+      if (static_cast<size_t>(node.mesh) >= model.meshes.size()) ThrowInputError("{}: mesh {} does not exist", where, node.mesh);
+      for (const tinygltf::Primitive& primitive : model.meshes[static_cast<size_t>(node.mesh)].primitives) {
+        if (primitive.mode != -1 && primitive.mode != TINYGLTF_MODE_TRIANGLES) continue;  // points, lines, strips
+        const auto position = primitive.attributes.find("POSITION");
+        if (position == primitive.attributes.end() || position->second < 0 ||
+            static_cast<size_t>(position->second) >= model.accessors.size()) {
+          ThrowInputError("{}: a primitive without POSITION", where);
+        }
+        const tinygltf::Accessor& pa = model.accessors[static_cast<size_t>(position->second)];
+        if (pa.type != TINYGLTF_TYPE_VEC3 || pa.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT) {
+          ThrowInputError("{}: POSITION must be float VEC3", where);
+        }
+        size_t stride = 0;
+        const unsigned char* pdata = AccessorData(model, pa, 12, &stride, where);
+        std::vector<glm::vec3> points(pa.count);
+        for (size_t v = 0; v < pa.count; ++v) {
+          glm::vec3 p;
+          std::memcpy(&p, pdata + v * stride, 12);
+          if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) ThrowInputError("{}: vertex {} is not finite", where, v);
+          points[v] = glm::vec3(y_up_to_z_up * world * glm::dvec4(glm::dvec3(p), 1.0));
+        }
+        std::vector<uint32_t> order;
+        if (primitive.indices >= 0) {
+          if (static_cast<size_t>(primitive.indices) >= model.accessors.size()) ThrowInputError("{}: indices accessor missing", where);
+          const tinygltf::Accessor& ia = model.accessors[static_cast<size_t>(primitive.indices)];
+          const size_t size = ia.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ? 1
+                              : ia.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2
+                              : ia.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT ? 4 : 0;
+          if (size == 0) ThrowInputError("{}: indices must be unsigned integers", where);
+          const unsigned char* idata = AccessorData(model, ia, size, &stride, where);
+          for (size_t k = 0; k < ia.count; ++k) {
+            uint32_t i = 0;
+            std::memcpy(&i, idata + k * stride, size);  // little-endian, as glTF is
+            if (i >= points.size()) ThrowInputError("{}: index {} past the {} vertices", where, i, points.size());
+            order.push_back(i);
+          }
+        } else {
+          for (size_t v = 0; v < points.size(); ++v) order.push_back(static_cast<uint32_t>(v));
+        }
+        // A mirroring transform turns the winding; keep the faces counter-clockwise from outside.
+        const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+        for (size_t k = 0; k + 2 < order.size(); k += 3) {
+          const glm::vec3 &a = points[order[k]], &b = points[order[k + 1]], &c = points[order[k + 2]];
+          if (mirrored) {
+            AddFlatTriangle(a, c, b, &mesh);
+          } else {
+            AddFlatTriangle(a, b, c, &mesh);
+          }
+        }
+      }
+    }
+    for (const int child : node.children) visit(child, world);
+  };
+  if (!model.scenes.empty()) {
+    const size_t scene = model.defaultScene >= 0 ? static_cast<size_t>(model.defaultScene) : 0;
+    if (scene >= model.scenes.size()) ThrowInputError("{}: scene {} does not exist", where, scene);
+    for (const int node : model.scenes[scene].nodes) visit(node, glm::dmat4(1.0));
+  } else {
+    for (size_t n = 0; n < model.nodes.size(); ++n) visit(static_cast<int>(n), glm::dmat4(1.0));
+  }
+  if (mesh.indices.empty()) ThrowInputError("{}: no triangles", where);
+  return mesh;
+}
+
+}  // namespace
+
 Mesh ObjectMesh(const VirtualObject& object) {
   Mesh mesh;
   switch (object.kind) {
     case MeshKind::kSphere: mesh = SphereMesh(static_cast<float>(object.radius), 48, 96); break;
     case MeshKind::kBox: mesh = BoxMesh(glm::vec3(object.size)); break;
     case MeshKind::kFile: {
-      const std::string ext = object.file.extension().string();
-      if (ext != ".obj") ThrowInputError("{}: only OBJ meshes are read so far", object.file.string());
+      if (object.file.extension() != ".obj") {
+        mesh = LoadGltfMesh(object.file);
+        break;
+      }
       const SceneModel model = LoadObjModel(object.file);
       if (model.triangles.empty()) ThrowInputError("{}: no triangles", object.file.string());
-      for (const Triangle& t : model.triangles) {
-        const glm::vec3 a = model.vertices[t.v[0]], b = model.vertices[t.v[1]], c = model.vertices[t.v[2]];
-        const glm::vec3 cross = glm::cross(b - a, c - a);
-        const glm::vec3 n = glm::length(cross) > 0.0f ? glm::normalize(cross) : glm::vec3(0, 0, 1);
-        for (const glm::vec3& p : {a, b, c}) {
-          mesh.indices.push_back(static_cast<uint32_t>(mesh.positions.size()));
-          mesh.positions.push_back(p);
-          mesh.normals.push_back(n);
-        }
-      }
+      for (const Triangle& t : model.triangles) AddFlatTriangle(model.vertices[t.v[0]], model.vertices[t.v[1]], model.vertices[t.v[2]], &mesh);
       break;
     }
   }
@@ -126,6 +247,29 @@ Mesh ObjectMesh(const VirtualObject& object) {
     mesh.normals[i] = glm::normalize(normal_matrix * mesh.normals[i]);
   }
   return mesh;
+}
+
+void CheckObjectsOutsideModel(const std::vector<VirtualObject>& objects, const RayCaster& real, const std::string& where) {
+  constexpr int kRays = 64;
+  for (size_t o = 0; o < objects.size(); ++o) {
+    const Mesh mesh = ObjectMesh(objects[o]);
+    glm::vec3 lo(1e30f), hi(-1e30f);
+    for (const glm::vec3& p : mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+    const glm::vec3 centre = 0.5f * (lo + hi);
+    int back = 0;
+    std::map<uint32_t, int> surfaces;
+    for (int k = 0; k < kRays; ++k) {
+      // A Fibonacci sphere of directions.
+      const float z = 1.0f - 2.0f * (static_cast<float>(k) + 0.5f) / kRays;
+      const float r = std::sqrt(std::max(0.0f, 1.0f - z * z)), phi = 2.39996323f * static_cast<float>(k);
+      const RayHit hit = real.Intersect(centre, glm::vec3(r * std::cos(phi), r * std::sin(phi), z));
+      if (hit.IsHit() && hit.back_face) ++back, ++surfaces[hit.surface];
+    }
+    if (back * 10 < kRays * 9) continue;
+    const auto most = std::max_element(surfaces.begin(), surfaces.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+    ThrowInputError("{}: objects[{}]: its centre ({:.2f}, {:.2f}, {:.2f}) is inside the model (surface '{}'); move it out",
+                    where, o, centre.x, centre.y, centre.z, real.model().surface_names[most->first]);
+  }
 }
 
 SceneModel ObjectsModel(const std::vector<VirtualObject>& objects) {

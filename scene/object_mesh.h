@@ -4,11 +4,13 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "scene/model.h"
+#include "scene/raycaster.h"
 #include "scene/scene.h"
 
 namespace daylit::scene {
@@ -25,14 +27,21 @@ Mesh SphereMesh(float radius, int stacks, int slices);
 Mesh BoxMesh(const glm::vec3& size);
 
 // The object's mesh placed in the scene: R = Rz·Ry·Rx from rotation_deg, then scale, then the
-// position. OBJ files get per-face normals. Throws InputError naming the file for a mesh that
-// cannot be read or has no triangles.
+// position. OBJ and glTF 2.0 files (.gltf, .glb: the default scene's triangle primitives, node
+// transforms applied, glTF's +Y up turned to the scene's +Z up) get per-face normals. Throws
+// InputError naming the file for a mesh that cannot be read or has no triangles.
 Mesh ObjectMesh(const VirtualObject& object);
 
 // Whether the triangles close a volume with consistent counter-clockwise-from-outside faces,
 // vertices welded by exact position: every edge is traversed once each way (triangles with two
 // equal vertices, a pole's fan, are skipped). The renderer culls such a mesh's back faces.
 bool IsClosedMesh(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices);
+
+// Throws InputError ("<where>: objects[i]: ... inside the model (surface 'x')") for an object
+// whose centre (its mesh's bounding-box centre) lies inside the real model: 9 in 10 of 64 rays
+// from it leave through the back of a face, as from inside a solid wall. `real` is over the
+// scene's model.
+void CheckObjectsOutsideModel(const std::vector<VirtualObject>& objects, const RayCaster& real, const std::string& where);
 
 // All the objects as one triangle model, surface i being object i (for a RayCaster).
 SceneModel ObjectsModel(const std::vector<VirtualObject>& objects);

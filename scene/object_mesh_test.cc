@@ -2,7 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
 #include <glm/gtc/constants.hpp>
+
+#include "base/error.h"
 
 
 namespace daylit::scene {
@@ -51,6 +58,88 @@ TEST(ObjectMeshTest, PlacementRotatesThenMoves) {
   EXPECT_NEAR(hi.y - lo.y, 2.0f, 1e-5f);
   EXPECT_NEAR(0.5f * (hi.y + lo.y), 2.0f, 1e-5f);
   EXPECT_NEAR(Volume(m), 2.0, 1e-5);  // still outward
+}
+
+// A tetrahedron written as glTF 2.0 (JSON + .bin): glTF's +Y up becomes the scene's +Z, the
+// node's translation applies, and the faces stay outward.
+TEST(ObjectMeshTest, GltfMeshesAreReadWithTheirNodesAndTurnedToZUp) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("daylit_gltf_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  // glTF coordinates: A(0,0,0) B(1,0,0) C(0,0,−1) D(0,2,0), i.e. scene (0,0,0) (1,0,0) (0,1,0) (0,0,2).
+  const float positions[12] = {0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 2, 0};
+  const uint16_t indices[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+  {
+    std::ofstream bin(dir / "tet.bin", std::ios::binary);
+    bin.write(reinterpret_cast<const char*>(positions), sizeof(positions));
+    bin.write(reinterpret_cast<const char*>(indices), sizeof(indices));
+  }
+  {
+    std::ofstream gltf(dir / "tet.gltf");
+    gltf << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+      "nodes": [{"mesh": 0, "translation": [1, 0, 0]}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+      "buffers": [{"uri": "tet.bin", "byteLength": 72}],
+      "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 24}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, -1], "max": [1, 2, 0]},
+                    {"bufferView": 1, "componentType": 5123, "count": 12, "type": "SCALAR"}]})";
+  }
+  VirtualObject object;
+  object.kind = MeshKind::kFile;
+  object.file = dir / "tet.gltf";
+  object.position = glm::dvec3(0.0, 0.0, 0.5);
+  const Mesh m = ObjectMesh(object);
+  ASSERT_EQ(m.indices.size(), 12u);
+  EXPECT_NEAR(Volume(m), 1.0 / 3.0, 1e-6) << "outward, the right size";
+  EXPECT_TRUE(IsClosedMesh(m.positions, m.indices));
+  glm::vec3 lo(1e9f), hi(-1e9f);
+  for (const glm::vec3& p : m.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  EXPECT_NEAR(lo.x, 1.0f, 1e-6f) << "the node's translation";
+  EXPECT_NEAR(hi.y, 1.0f, 1e-6f) << "glTF's −Z is the scene's +Y";
+  EXPECT_NEAR(hi.z, 2.5f, 1e-6f) << "glTF's +Y is the scene's +Z, then the object's position";
+  // Not a mesh: a clear error naming the file.
+  std::ofstream(dir / "bad.gltf") << "this is not json";
+  std::ofstream(dir / "bad.glb") << "glTF but not binary";
+  for (const char* name : {"bad.gltf", "bad.glb"}) {
+    object.file = dir / name;
+    try {
+      ObjectMesh(object);
+      ADD_FAILURE() << name << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string(name) + ": not a glTF 2.0 file"), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// A solid wall (a closed box, faces outward): a sphere whose centre is in it is refused, naming
+// the object and the wall; one beside it, or sunk halfway into the ground plane, is fine.
+TEST(ObjectMeshTest, AnObjectInsideAWallIsRefused) {
+  SceneModel model;
+  const Mesh wall = BoxMesh(glm::vec3(4.0f, 0.3f, 3.0f));
+  for (const glm::vec3& p : wall.positions) model.vertices.push_back(p + glm::vec3(0.0f, 0.0f, 1.5f));
+  for (size_t t = 0; t < wall.indices.size(); t += 3) model.triangles.push_back({{wall.indices[t], wall.indices[t + 1], wall.indices[t + 2]}, 0});
+  model.surface_names = {"wall_north"};
+  const auto ground = static_cast<uint32_t>(model.vertices.size());
+  model.vertices.insert(model.vertices.end(), {{-9, -9, 0}, {9, -9, 0}, {9, 9, 0}, {-9, 9, 0}});
+  model.triangles.push_back({{ground, ground + 1, ground + 2}, 1});
+  model.triangles.push_back({{ground, ground + 2, ground + 3}, 1});
+  model.surface_names.push_back("ground");
+  const RayCaster caster(model);
+  VirtualObject sphere;
+  sphere.radius = 0.5;
+  sphere.position = glm::dvec3(1.0, 2.0, 0.5);
+  EXPECT_NO_THROW(CheckObjectsOutsideModel({sphere}, caster, "scene.json"));
+  sphere.position = glm::dvec3(1.0, 2.0, 0.0);  // half in the ground: the ground is a surface, not a solid
+  EXPECT_NO_THROW(CheckObjectsOutsideModel({sphere}, caster, "scene.json"));
+  VirtualObject inside = sphere;
+  inside.position = glm::dvec3(0.5, 0.05, 1.0);
+  try {
+    CheckObjectsOutsideModel({sphere, inside}, caster, "scene.json");
+    ADD_FAILURE() << "an object inside the wall was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scene.json: objects[1]: its centre (0.50, 0.05, 1.00) is inside the model (surface 'wall_north')"),
+              std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
