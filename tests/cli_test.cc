@@ -427,6 +427,41 @@ TEST(CliTest, ReplayWritesTheAugmentedVideoAndItsReport) {
   fs::remove_all(dir);
 }
 
+// --window under Xvfb (installed by scripts/setup.sh): the window shows the composite, encoded
+// like the video, with the overlay; read back from its framebuffer at the end.
+TEST(CliTest, ReplayInAWindowShowsTheComposite) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_window_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string cache = std::string(DAYLIT_BINARY_DIR) + "/test-cache/courtyard-a";
+  const CliRun run = Daylit("replay " + kRecording + " --window --frames 41 --cache " + cache + " --out " +
+                                (dir / "w.mp4").string() + " --screenshot " + (dir / "shot.png").string(),
+                            kGlEnvironment + "xvfb-run -a -s '-screen 0 1280x1024x24' ");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const cv::Mat shot = cv::imread((dir / "shot.png").string());
+  ASSERT_EQ(shot.cols, 960);
+  ASSERT_EQ(shot.rows, 540);
+  // The last frame shown is frame 40: the objects where the truth's mask has them, the far wall
+  // as the video's frame 40 (away from the overlay), the overlay's white text top left.
+  capture::VideoDecoder original(kRecording + "/video.mp4");
+  cv::Mat frame;
+  for (int i = 0; i <= 40; ++i) ASSERT_TRUE(original.Next(&frame));
+  cv::Mat expected;
+  frame.convertTo(expected, CV_8UC3, 255.0);
+  cv::cvtColor(expected, expected, cv::COLOR_RGB2BGR);
+  cv::Mat difference;
+  cv::absdiff(shot, expected, difference);
+  cv::cvtColor(difference, difference, cv::COLOR_BGR2GRAY);
+  const cv::Mat mask = cv::imread(kRecording + "/groundtruth/objects_mask/000040.png", cv::IMREAD_GRAYSCALE);
+  EXPECT_GT(cv::mean(difference, mask >= 128)[0], 10.0) << "the objects are not in the window";
+  EXPECT_LT(cv::mean(difference(cv::Rect(300, 100, 560, 90)))[0], 1.0) << "codes off on the far wall";
+  cv::Mat overlay;
+  cv::inRange(shot(cv::Rect(0, 0, 400, 80)), cv::Scalar(250, 250, 250), cv::Scalar(255, 255, 255), overlay);
+  EXPECT_GT(cv::countNonZero(overlay), 200) << "no overlay text";
+  // With --out as well, the video is written too.
+  EXPECT_TRUE(fs::is_regular_file(dir / "w.mp4"));
+  fs::remove_all(dir);
+}
+
 TEST(CliTest, ReplayAndRenderWithoutOpenGlSayWhy) {
   const fs::path dir = fs::temp_directory_path() / ("daylit_cli_nogl_" + std::to_string(::getpid()));
   fs::create_directories(dir);
@@ -438,6 +473,10 @@ TEST(CliTest, ReplayAndRenderWithoutOpenGlSayWhy) {
     EXPECT_EQ(run.exit_code, 2) << args;
     EXPECT_NE(run.err.find("OpenGL: no EGL display"), std::string::npos) << run.err;
   }
+  // No display for --window: said so.
+  const CliRun headless = Daylit("replay " + kRecording + " --window --frames 5", kGlEnvironment + "env -u DISPLAY -u WAYLAND_DISPLAY ");
+  EXPECT_EQ(headless.exit_code, 2);
+  EXPECT_NE(headless.err.find("--window: no display for a window"), std::string::npos) << headless.err;
   EXPECT_TRUE(fs::is_empty(dir)) << "an output was left behind";
   fs::remove_all(dir);
 }
@@ -489,6 +528,7 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"replay " + kRecording + " --out " + dir + "/no/such/r.mp4", "--out: " + dir + "/no/such: no such folder"},
       {"replay " + kRecording + " --out /proc/r.mp4", "--out: cannot write /proc/r.mp4"},
       {"replay " + kRecording + " --frames 0", "--frames: 0 is not a number of frames"},
+      {"replay " + kRecording + " --screenshot " + dir + "/s.png", "--screenshot: needs --window"},
   };
   for (const BadCall& call : calls) {
     const CliRun run = Daylit(call.args);  // NOLINT

@@ -1,7 +1,9 @@
 // daylit replay: the main job. Every frame of a recording through the whole pipeline (bake,
 // capture, sun, estimation, relighting, irradiance volume, compositing) into an augmented H.264
 // video, with the estimates, their plot and a report beside it (docs/render.md).
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
@@ -18,6 +20,7 @@
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "apps/daylit/commands.h"
 #include "bake/bake.h"
@@ -25,12 +28,14 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "base/statistics.h"
+#include "capture/frame_source.h"
 #include "capture/response.h"
 #include "capture/video_encoder.h"
 #include "estimation/recording_estimator.h"
 #include "render/composite_truth.h"
 #include "render/frame_renderer.h"
 #include "render/gl_context.h"
+#include "render/gl_window.h"
 #include "report/plot.h"
 #include "scene/hdr_image.h"
 #include "scene/scene.h"
@@ -48,8 +53,37 @@ struct ReplayOptions {
   std::string recording;
   std::string cache;
   std::string out = "replay.mp4";
+  bool out_given = false;
   std::optional<int> frames;
+  bool window = false;
+  std::string screenshot;
 };
+
+// The window's overlay, drawn into the shown image: frames per second, the sun, and E_sun and
+// E_sky as swatches of their colour with their values.
+void DrawOverlay(cv::Mat* bgr, double fps, const estimation::FrameEstimate& row) {
+  const auto text = [&](const std::string& line, int x, int y) {
+    cv::putText(*bgr, line, {x, y}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+    cv::putText(*bgr, line, {x, y}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  };
+  text(fmt::format("frame {}  {:.0f} fps  sun {:.1f} deg up, {:.1f} deg az", row.frame, fps, row.sun_elevation_deg,
+                   row.sun_azimuth_deg), 12, 22);
+  int y = 34;
+  for (const bool sun : {true, false}) {
+    const glm::dvec3 e = sun ? row.light.sun_rgb : row.light.sky_rgb;
+    const double top = std::max({e.x, e.y, e.z, 1e-9});
+    // The light's colour at full brightness, sRGB-encoded.
+    cv::Scalar colour;
+    for (int c = 0; c < 3; ++c) {
+      const double v = std::clamp(e[c] / top, 0.0, 1.0);
+      colour[2 - c] = 255.0 * (v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055);
+    }
+    cv::rectangle(*bgr, cv::Rect(12, y, 24, 16), colour, cv::FILLED);
+    cv::rectangle(*bgr, cv::Rect(12, y, 24, 16), cv::Scalar(255, 255, 255), 1);
+    text(fmt::format("{} {:.3g} {:.3g} {:.3g}", sun ? "E_sun" : "E_sky", e.x, e.y, e.z), 44, y + 13);
+    y += 22;
+  }
+}
 
 // The path tracer's frames with the objects, where the recording has them (groundtruth/).
 class TruthComposites {
@@ -218,8 +252,13 @@ void RunReplay(const ReplayOptions& o) {
   if (o.frames && *o.frames < 1) ThrowInputError("--frames: {} is not a number of frames", *o.frames);
   const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
   const scene::Scene scene = scene::LoadScene(o.recording);
+  if (!o.screenshot.empty() && !o.window) ThrowInputError("--screenshot: needs --window");
+  if (!o.screenshot.empty() && fs::path(o.screenshot).extension() != ".png") ThrowInputError("--screenshot: {} must end in .png", o.screenshot);
   // Everything that can fail without the bake fails before it: the frames, GL, the output.
   std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
+  // In a window, a recording plays at its own pace; a camera paces itself.
+  if (o.window && scene.frame_times) source = capture::Paced(std::move(source), 1.0);
+  const bool write_video = !o.window || o.out_given;
   if (!fs::is_directory(dir)) ThrowInputError("--out: {}: no such folder", dir.string());
   fs::path partial = TemporarySibling(out);
   partial += ext;  // the container is chosen by the extension
@@ -230,15 +269,24 @@ void RunReplay(const ReplayOptions& o) {
       if (!path.empty()) fs::remove(path, ec);
     }
   } cleanup{partial};
+  if (!write_video) cleanup.path.clear();
   std::optional<VideoThread> video;
   try {
-    video.emplace(partial, scene.intrinsics.width, scene.intrinsics.height, scene::NominalFps(scene), scene.response);
+    if (write_video) video.emplace(partial, scene.intrinsics.width, scene.intrinsics.height, scene::NominalFps(scene), scene.response);
   } catch (const InputError& e) {
     ThrowInputError("--out: cannot write {} ({})", out.string(), e.what());
   }
+  // GL: a window's context, or a headless one.
   std::string why;
-  const auto gl = render::HeadlessGlContext::Create(&why);
-  if (gl == nullptr) ThrowInputError("OpenGL: {}", why);
+  std::unique_ptr<render::GlWindow> window;
+  std::unique_ptr<render::HeadlessGlContext> gl;
+  if (o.window) {
+    window = render::GlWindow::Create(scene.intrinsics.width, scene.intrinsics.height, "daylit: " + scene.name, &why);
+    if (window == nullptr) ThrowInputError("--window: {}", why);
+  } else {
+    gl = render::HeadlessGlContext::Create(&why);
+    if (gl == nullptr) ThrowInputError("OpenGL: {}", why);
+  }
 
   bool loaded = false;
   const fs::path cache = bake::CacheDir(scene, o.cache);
@@ -246,7 +294,7 @@ void RunReplay(const ReplayOptions& o) {
   Log().info("{} the bake: {}", loaded ? "loaded" : "made", cache.string());
   const scene::RayCaster caster(scene.model);
   render::FrameRenderer renderer(scene, baked, caster);
-  Log().info("rendering with {} ({})", gl->renderer(), gl->platform());
+  if (gl) Log().info("rendering with {} ({})", gl->renderer(), gl->platform());
   const int w = renderer.width(), h = renderer.height();
 
   const TruthComposites truth(scene);
@@ -254,6 +302,10 @@ void RunReplay(const ReplayOptions& o) {
   double worst = -1.0;
   std::vector<float> composite, truth_frame;
   std::vector<double> render_ms;
+  const capture::Encoder to_screen(scene.response);
+  cv::Mat shown_rgb(h, w, CV_32FC3), shown;
+  Clock::time_point last_shown = Clock::now();
+  double shown_fps = 0.0;
   estimation::EstimateOptions options;
   options.max_frames = o.frames;
   options.progress_label = "replay";
@@ -263,11 +315,11 @@ void RunReplay(const ReplayOptions& o) {
                          double overcast_share) {
     // A frame that could not be read shows the last one again, so the video keeps its timing.
     if (frame.rgb.empty()) {
-      video->Write({}, 1.0);
+      if (video) video->Write({}, 1.0);
       return;
     }
     const Clock::time_point t0 = Clock::now();
-    composite = video->TakeBuffer();
+    if (video) composite = video->TakeBuffer();
     renderer.Render(frame, row.light, overcast_share, sun_dir, &composite);
     render_ms.push_back(1e3 * std::chrono::duration<double>(Clock::now() - t0).count());
     if (const auto f = truth.Compare(frame, renderer, composite, &truth_frame)) {
@@ -279,14 +331,28 @@ void RunReplay(const ReplayOptions& o) {
                                     scene.response);
       }
     }
-    video->Write(std::move(composite), frame.exposure);
+    if (window) {
+      to_screen.Apply(composite.data(), static_cast<float>(frame.exposure), shown_rgb.ptr<float>(), composite.size());
+      shown_rgb.convertTo(shown, CV_8UC3, 255.0);
+      cv::cvtColor(shown, shown, cv::COLOR_RGB2BGR);
+      const Clock::time_point now = Clock::now();
+      const double dt = std::chrono::duration<double>(now - last_shown).count();
+      shown_fps = shown_fps == 0.0 ? 1.0 / std::max(dt, 1e-3) : 0.9 * shown_fps + 0.1 / std::max(dt, 1e-3);
+      last_shown = now;
+      DrawOverlay(&shown, shown_fps, row);
+      if (!window->Show(shown)) g_stop_replay = true;  // closed: end as Ctrl-C does
+    }
+    if (video) video->Write(std::move(composite), frame.exposure);
   };
   std::signal(SIGINT, StopReplay);
   const estimation::EstimateRun run = estimation::EstimateRecording(scene, baked, options, std::move(source));
   std::signal(SIGINT, SIG_DFL);
-  video->Finish();
-  CommitTemporary(partial, out);
-  cleanup.path.clear();
+  if (video) {
+    video->Finish();
+    CommitTemporary(partial, out);
+    cleanup.path.clear();
+  }
+  if (!o.screenshot.empty()) report::WritePng(o.screenshot, {window->Screenshot()});
 
   const size_t n = run.frames.size();
   fmt::memory_buffer report;
@@ -330,7 +396,7 @@ void RunReplay(const ReplayOptions& o) {
     PlotFidelity(fidelity, scene.name, dir / "fidelity.png");
   }
   WriteFileAtomically(dir / "report.txt", fmt::to_string(report));
-  Log().info("wrote {}, estimates.csv, lighting.png, report.txt{} in {}", out.filename().string(),
+  Log().info("wrote {}estimates.csv, lighting.png, report.txt{} in {}", video ? out.filename().string() + ", " : "",
              fidelity.empty() ? "" : ", fidelity.csv, fidelity.png, worst_vs_truth.png", dir.string());
 }
 
@@ -345,9 +411,16 @@ void AddReplayCommand(CLI::App& app) {
               "fidelity.csv, fidelity.png and worst_vs_truth.png. Ctrl-C ends it with a complete video.");
   cmd->add_option("recording", options->recording, "Recording folder or its scene.json")->required();
   cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
-  cmd->add_option("--out", options->out, "Augmented video, .mp4 or .mkv (default replay.mp4)");
+  CLI::Option* out = cmd->add_option("--out", options->out, "Augmented video, .mp4 or .mkv (default replay.mp4); its folder gets the report");
   cmd->add_option("--frames", options->frames, "Stop after this many frames");
-  cmd->callback([options] { RunReplay(*options); });
+  cmd->add_flag("--window", options->window,
+                "Show it in a window instead of writing the video (at the recording's pace, with fps, the sun and "
+                "E_sun/E_sky swatches); --out as well writes both; Esc, Q or closing the window ends it");
+  cmd->add_option("--screenshot", options->screenshot, "With --window: the window's last frame as a PNG");
+  cmd->callback([options, out] {
+    options->out_given = out->count() > 0;
+    RunReplay(*options);
+  });
 }
 
 }  // namespace daylit::app
