@@ -59,7 +59,7 @@ const std::string kRecording = DAYLIT_SOURCE_DIR "/recordings/courtyard-a";
 const std::string kProbe = DAYLIT_SOURCE_DIR "/probes/stpeters_latlong_1024x512.hdr";
 
 TEST(CliTest, HelpForEverySubcommand) {
-  for (const char* sub : {"", "sunpos ", "info ", "lights ", "record ", "render ", "replay ", "calibrate-response ", "calibrate-camera "}) {
+  for (const char* sub : {"", "sunpos ", "info ", "lights ", "record ", "render ", "replay ", "live ", "calibrate-response ", "calibrate-camera "}) {
     const CliRun run = Daylit(std::string(sub) + "--help");
     EXPECT_EQ(run.exit_code, 0) << sub;
     EXPECT_NE(run.out.find("Usage"), std::string::npos) << sub << run.out;
@@ -493,6 +493,9 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
   const fs::path live_scene = live.Write();
   const BadCall calls[] = {
       {"estimate " + live_scene.string(), "/dev/video-daylit-absent: cannot open (No such file or directory); is the camera plugged in?"},
+      {"live --scene " + live_scene.string() + " --out " + dir + "/live.mp4",
+       "/dev/video-daylit-absent: cannot open (No such file or directory); is the camera plugged in?"},
+      {"live --scene " + kRecording, "frames name recorded frames, not a camera; replay them with daylit replay"},
       {"info /no/such/recording", "/no/such/recording: no such file or folder"},
       {"info " + dir + "/broken.json", "broken.json: invalid JSON"},
       {"info " + nan_scene.string(), "nan.obj:3: vertex coordinate y is not a finite number ('nan')"},

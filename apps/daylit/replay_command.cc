@@ -50,6 +50,7 @@ std::atomic<bool> g_stop_replay{false};
 extern "C" void StopReplay(int) { g_stop_replay = true; }
 
 struct ReplayOptions {
+  bool live = false;  // daylit live: the scene's camera
   std::string recording;
   std::string cache;
   std::string out = "replay.mp4";
@@ -252,6 +253,9 @@ void RunReplay(const ReplayOptions& o) {
   if (o.frames && *o.frames < 1) ThrowInputError("--frames: {} is not a number of frames", *o.frames);
   const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
   const scene::Scene scene = scene::LoadScene(o.recording);
+  if (o.live && scene.frames.kind != scene::FrameSourceKind::kDevice) {
+    ThrowInputError("--scene: {}: frames name recorded frames, not a camera; replay them with daylit replay", scene.file.string());
+  }
   if (!o.screenshot.empty() && !o.window) ThrowInputError("--screenshot: needs --window");
   if (!o.screenshot.empty() && fs::path(o.screenshot).extension() != ".png") ThrowInputError("--screenshot: {} must end in .png", o.screenshot);
   // Everything that can fail without the bake fails before it: the frames, GL, the output.
@@ -360,6 +364,7 @@ void RunReplay(const ReplayOptions& o) {
     fmt::print("{}\n", line);
     fmt::format_to(std::back_inserter(report), "{}\n", line);
   };
+  if (run.undecodable > 0 && o.live) Log().warn("{} frames could not be read from the camera", run.undecodable);
   say(fmt::format("{}: {} frames in {:.1f} s, {:.1f} fps end to end (decode, estimate, relight, render, encode)",
                   scene.name, n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9)));
   say(fmt::format("  per frame (median): estimate {:.1f} ms, relight + render {:.1f} ms (encoding on its own thread)",
@@ -416,6 +421,26 @@ void AddReplayCommand(CLI::App& app) {
   cmd->add_flag("--window", options->window,
                 "Show it in a window instead of writing the video (at the recording's pace, with fps, the sun and "
                 "E_sun/E_sky swatches); --out as well writes both; Esc, Q or closing the window ends it");
+  cmd->add_option("--screenshot", options->screenshot, "With --window: the window's last frame as a PNG");
+  cmd->callback([options, out] {
+    options->out_given = out->count() > 0;
+    RunReplay(*options);
+  });
+}
+
+void AddLiveCommand(CLI::App& app) {
+  auto options = std::make_shared<ReplayOptions>();
+  options->live = true;
+  options->out = "live.mp4";
+  CLI::App* cmd = app.add_subcommand("live", "The replay's pipeline on the scene's V4L2 camera, to a video or a window");
+  cmd->footer("scene.json's frames name the device ({\"device\": \"/dev/video0\", \"fps\": 30}); its exposure, gain\n"
+              "and white balance are locked as for daylit record. Opens the camera before the bake. Runs until\n"
+              "--frames, Ctrl-C, or (with --window) the window is closed; the video and report are then complete.");
+  cmd->add_option("--scene", options->recording, "scene.json whose frames name a camera")->required();
+  cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
+  CLI::Option* out = cmd->add_option("--out", options->out, "Augmented video, .mp4 or .mkv (default live.mp4); its folder gets the report");
+  cmd->add_option("--frames", options->frames, "Stop after this many frames");
+  cmd->add_flag("--window", options->window, "Show it in a window instead of writing the video (--out as well: both)");
   cmd->add_option("--screenshot", options->screenshot, "With --window: the window's last frame as a PNG");
   cmd->callback([options, out] {
     options->out_given = out->count() > 0;
