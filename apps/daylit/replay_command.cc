@@ -407,25 +407,36 @@ void RunReplay(const ReplayOptions& o) {
 
 }  // namespace
 
+namespace {
+
+// What replay and live share: the cache, the video and report, the frame count, the window.
+void AddPipelineOptions(CLI::App* cmd, const std::shared_ptr<ReplayOptions>& options, const std::string& default_out) {
+  cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
+  CLI::Option* out = cmd->add_option("--out", options->out,
+                                     "Augmented video, .mp4 or .mkv (default " + default_out + "); its folder gets the report");
+  cmd->add_option("--frames", options->frames, "Stop after this many frames");
+  cmd->add_flag("--window", options->window,
+                "Show it in a window instead of writing the video (with fps, the sun and E_sun/E_sky swatches); "
+                "--out as well writes both; Esc, Q or closing the window ends it");
+  cmd->add_option("--screenshot", options->screenshot, "With --window: the window's last frame as a PNG");
+  cmd->callback([options, out] {
+    options->out_given = out->count() > 0;
+    RunReplay(*options);
+  });
+}
+
+}  // namespace
+
 void AddReplayCommand(CLI::App& app) {
   auto options = std::make_shared<ReplayOptions>();
   CLI::App* cmd = app.add_subcommand("replay", "The whole pipeline over a recording, into an augmented video");
   cmd->footer("Bakes (cached), then for every frame: decode, sun, estimate, relight the env map, update the\n"
               "irradiance volume, composite the objects with OpenGL (EGL, no display needed), encode H.264.\n"
               "Beside the video: estimates.csv, lighting.png, report.txt; with the recording's ground truth,\n"
-              "fidelity.csv, fidelity.png and worst_vs_truth.png. Ctrl-C ends it with a complete video.");
+              "fidelity.csv, fidelity.png and worst_vs_truth.png. Ctrl-C ends it with a complete video.\n"
+              "--window plays it at the recording's pace.");
   cmd->add_option("recording", options->recording, "Recording folder or its scene.json")->required();
-  cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
-  CLI::Option* out = cmd->add_option("--out", options->out, "Augmented video, .mp4 or .mkv (default replay.mp4); its folder gets the report");
-  cmd->add_option("--frames", options->frames, "Stop after this many frames");
-  cmd->add_flag("--window", options->window,
-                "Show it in a window instead of writing the video (at the recording's pace, with fps, the sun and "
-                "E_sun/E_sky swatches); --out as well writes both; Esc, Q or closing the window ends it");
-  cmd->add_option("--screenshot", options->screenshot, "With --window: the window's last frame as a PNG");
-  cmd->callback([options, out] {
-    options->out_given = out->count() > 0;
-    RunReplay(*options);
-  });
+  AddPipelineOptions(cmd, options, "replay.mp4");
 }
 
 void AddLiveCommand(CLI::App& app) {
@@ -437,15 +448,7 @@ void AddLiveCommand(CLI::App& app) {
               "and white balance are locked as for daylit record. Opens the camera before the bake. Runs until\n"
               "--frames, Ctrl-C, or (with --window) the window is closed; the video and report are then complete.");
   cmd->add_option("--scene", options->recording, "scene.json whose frames name a camera")->required();
-  cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
-  CLI::Option* out = cmd->add_option("--out", options->out, "Augmented video, .mp4 or .mkv (default live.mp4); its folder gets the report");
-  cmd->add_option("--frames", options->frames, "Stop after this many frames");
-  cmd->add_flag("--window", options->window, "Show it in a window instead of writing the video (--out as well: both)");
-  cmd->add_option("--screenshot", options->screenshot, "With --window: the window's last frame as a PNG");
-  cmd->callback([options, out] {
-    options->out_given = out->count() > 0;
-    RunReplay(*options);
-  });
+  AddPipelineOptions(cmd, options, "live.mp4");
 }
 
 }  // namespace daylit::app
