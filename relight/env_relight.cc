@@ -87,36 +87,33 @@ bool EnvRelighter::SetSun(const glm::vec3& sun_dir) {
   return true;
 }
 
+LightParts SplitLight(const estimation::SunSky& light, double overcast_share) {
+  const float o = static_cast<float>(std::clamp(overcast_share, 0.0, 1.0));
+  const glm::vec3 sky(light.sky_rgb);
+  return {glm::vec3(light.sun_rgb), (1.0f - o) * sky, o * sky};
+}
+
 void EnvRelighter::Relight(const estimation::SunSky& light, double overcast_share,
                            std::vector<glm::vec3>* radiance) const {
   const bake::EnvMapMaps& env = bake_.env;
   radiance->resize(env.surface.size());
-  const glm::vec3 sun(light.sun_rgb), sky(light.sky_rgb);
-  const float o = static_cast<float>(std::clamp(overcast_share, 0.0, 1.0));
-  const glm::vec3 clear_sky = (1.0f - o) * sky, overcast_sky = o * sky;
+  const LightParts e = SplitLight(light, overcast_share);
   // Sky texels first (model texels overwrite theirs below).
-  const glm::vec3 uniform = overcast_sky * glm::one_over_pi<float>();
-  for (size_t t = 0; t < sky_shape_.size(); ++t) (*radiance)[t] = clear_sky * sky_shape_[t] + uniform;
+  const glm::vec3 uniform = e.overcast * glm::one_over_pi<float>();
+  for (size_t t = 0; t < sky_shape_.size(); ++t) (*radiance)[t] = e.clear * sky_shape_[t] + uniform;
   for (size_t i = 0; i < model_texels_.size(); ++i) {
     const estimation::Transfer& T = terms_[i];
     const uint32_t t = model_texels_[i];
-    (*radiance)[t] = env.albedo[t] * glm::one_over_pi<float>() * (sun * T.sun + clear_sky * T.clear + overcast_sky * T.overcast);
+    (*radiance)[t] = env.albedo[t] * glm::one_over_pi<float>() * (e.sun * T.sun + e.clear * T.clear + e.overcast * T.overcast);
   }
 }
 
 void EnvRelighter::Basis(EnvBasis* basis) const {
-  const bake::EnvMapMaps& env = bake_.env;
-  for (std::vector<glm::vec3>* map : {&basis->sun, &basis->clear, &basis->overcast}) map->assign(env.surface.size(), glm::vec3(0.0f));
-  for (size_t t = 0; t < sky_shape_.size(); ++t) {
-    basis->clear[t] = sky_shape_[t];
-    basis->overcast[t] = glm::vec3(glm::one_over_pi<float>());
-  }
-  for (size_t i = 0; i < model_texels_.size(); ++i) {
-    const estimation::Transfer& T = terms_[i];
-    const uint32_t t = model_texels_[i];
-    const glm::vec3 k = env.albedo[t] * glm::one_over_pi<float>();
-    basis->sun[t] = k * T.sun, basis->clear[t] = k * T.clear, basis->overcast[t] = k * T.overcast;
-  }
+  // The map under each light alone, at unit strength.
+  const estimation::SunSky sun_only{glm::dvec3(1.0), glm::dvec3(0.0)}, sky_only{glm::dvec3(0.0), glm::dvec3(1.0)};
+  Relight(sun_only, 0.0, &basis->sun);
+  Relight(sky_only, 0.0, &basis->clear);
+  Relight(sky_only, 1.0, &basis->overcast);
 }
 
 namespace {

@@ -31,11 +31,8 @@ ObjectShadows::ObjectShadows(const scene::Scene& scene, const bake::SceneBake& b
     : gbuffer_(bake.camera), real_(real), objects_(objects), options_(options) {
   const bake::CameraGBuffer& gbuffer = bake.camera;
   // Bounding spheres from the meshes themselves (surface i of the objects' model is object i).
-  const scene::SceneModel& model = objects.model();
-  std::vector<glm::vec3> lo(scene.objects.size(), glm::vec3(1e30f)), hi(scene.objects.size(), glm::vec3(-1e30f));
-  for (const scene::Triangle& t : model.triangles) {
-    for (const uint32_t v : t.v) lo[t.surface] = glm::min(lo[t.surface], model.vertices[v]), hi[t.surface] = glm::max(hi[t.surface], model.vertices[v]);
-  }
+  std::vector<glm::vec3> lo, hi;
+  objects.model().SurfaceBounds(&lo, &hi);
   for (size_t o = 0; o < lo.size(); ++o) {
     if (lo[o].x > hi[o].x) continue;
     const glm::vec3 centre = 0.5f * (lo[o] + hi[o]);
@@ -192,9 +189,8 @@ void ObjectShadows::Apply(const estimation::SunSky& light, double overcast_share
   // pixel then keeps the share (B − ΔB)/B of its own value, noise included. All B are read
   // before any pixel changes.
   const int w = gbuffer_.width;
-  const glm::vec3 sun(light.sun_rgb), sky(light.sky_rgb);
-  const float o = static_cast<float>(std::clamp(overcast_share, 0.0, 1.0));
-  const glm::vec3 clear = (1.0f - o) * sky, overcast = o * sky;
+  const LightParts e = SplitLight(light, overcast_share);
+  const glm::vec3 sky(light.sky_rgb);
   keep_.resize(affected_.size());
   if (affected_.empty()) return;
   // Where all 25 neighbours are on the pixel's surface (most pixels), B is a 5×5 box filter of
@@ -209,9 +205,9 @@ void ObjectShadows::Apply(const estimation::SunSky& light, double overcast_share
   tbb::parallel_for(tbb::blocked_range<size_t>(0, affected_.size(), 2048), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
       const Affected& a = affected_[i];
-      glm::vec3 lost = sun * (a.cos_sun * (a.sun_real - a.sun_with));
+      glm::vec3 lost = e.sun * (a.cos_sun * (a.sun_real - a.sun_with));
       if (a.covers) {
-        lost += has_basis_ ? sun * a.covered_sun + clear * a.covered_clear + overcast * a.covered_overcast : sky * a.sky_lost;
+        lost += has_basis_ ? e.sun * a.covered_sun + e.clear * a.covered_clear + e.overcast * a.covered_overcast : sky * a.sky_lost;
       }
       glm::vec3 b(0.0f);
       if (a.neighbours == kAllNeighbours) {

@@ -3,9 +3,36 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "base/error.h"
 #include "report/plot.h"
+#include "scene/hdr_image.h"
 
 namespace daylit::render {
+
+std::optional<TruthFrame> ReadTruthFrame(const scene::Scene& scene, int index) {
+  namespace fs = std::filesystem;
+  if (!scene.groundtruth.composites) return std::nullopt;
+  const fs::path dir = *scene.groundtruth.composites;
+  TruthFrame truth;
+  truth.with_file = dir / "with_objects" / fmt::format("{:06d}.exr", index);
+  const fs::path without_file = dir / "without_objects" / fmt::format("{:06d}.exr", index);
+  const fs::path mask_file = dir / "objects_mask" / fmt::format("{:06d}.png", index);
+  if (!fs::is_regular_file(truth.with_file) || !fs::is_regular_file(without_file) || !fs::is_regular_file(mask_file)) {
+    return std::nullopt;
+  }
+  scene::HdrImage with = scene::ReadHdrImage(truth.with_file), without = scene::ReadHdrImage(without_file);
+  truth.mask = cv::imread(mask_file.string(), cv::IMREAD_GRAYSCALE);
+  const int w = scene.intrinsics.width, h = scene.intrinsics.height;
+  if (with.width != w || with.height != h || without.width != w || without.height != h || truth.mask.cols != w ||
+      truth.mask.rows != h) {
+    ThrowInputError("{}: the truth of frame {} is not {}x{}", dir.string(), index, w, h);
+  }
+  truth.with = std::move(with.rgb), truth.without = std::move(without.rgb);
+  return truth;
+}
 
 CompositeFidelity CompareComposite(const std::vector<float>& composite, const std::vector<float>& frame,
                                    const std::vector<float>& truth_with, const std::vector<float>& truth_without,

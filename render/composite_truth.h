@@ -6,13 +6,26 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "capture/response.h"
+#include "scene/scene.h"
 
 namespace daylit::render {
+
+// The path tracer's frame `index` (groundtruth/ of recording-format.md): with the objects and
+// without them (linear RGB, row-major from the top) and the objects' mask (8-bit).
+struct TruthFrame {
+  std::filesystem::path with_file;
+  std::vector<float> with, without;
+  cv::Mat mask;
+};
+// nullopt when the recording has no composites for that frame; InputError naming the folder when
+// they are not the camera's size.
+std::optional<TruthFrame> ReadTruthFrame(const scene::Scene& scene, int index);
 
 struct CompositeFidelity {
   double object_error = 0.0;

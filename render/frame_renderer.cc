@@ -2,8 +2,6 @@
 
 #include <tbb/parallel_for.h>
 
-#include <algorithm>
-
 #include "base/error.h"
 #include "scene/object_mesh.h"
 
@@ -20,7 +18,7 @@ FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& b
       relighter_(bake, scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f), caster),
       compositor_(scene, options),
       linearizer_(scene.response) {
-  scene::CheckObjectsOutsideModel(scene.objects, caster, scene.file.string());
+  scene::CheckObjectsOutsideModel(objects_model_, caster, scene.file.string());
   if (!bake.gather.directions.empty()) {
     volume_ = std::make_unique<relight::IrradianceVolume>(bake.gather, relight::ProbesInsideModel(bake.gather, caster));
   }
@@ -68,9 +66,8 @@ void FrameRenderer::Render(const capture::Frame& frame, const estimation::SunSky
         volume_parts_[i] = volume_->coefficients();
       }
     }
-    const float o = static_cast<float>(std::clamp(overcast_share, 0.0, 1.0));
-    const glm::vec3 sun(light.sun_rgb), sky(light.sky_rgb);
-    volume_->SetCombination({&volume_parts_[0], &volume_parts_[1], &volume_parts_[2]}, {sun, (1.0f - o) * sky, o * sky});
+    const relight::LightParts e = relight::SplitLight(light, overcast_share);
+    volume_->SetCombination({&volume_parts_[0], &volume_parts_[1], &volume_parts_[2]}, {e.sun, e.clear, e.overcast});
     input.volume = volume_.get();
   }
   shadows_.SetSun(sun_dir);

@@ -70,6 +70,17 @@ void SceneModel::Bounds(glm::vec3* lo, glm::vec3* hi) const {
   }
 }
 
+void SceneModel::SurfaceBounds(std::vector<glm::vec3>* lo, std::vector<glm::vec3>* hi) const {
+  lo->assign(surface_names.size(), glm::vec3(std::numeric_limits<float>::max()));
+  hi->assign(surface_names.size(), glm::vec3(std::numeric_limits<float>::lowest()));
+  for (const Triangle& t : triangles) {
+    for (const uint32_t v : t.v) {
+      (*lo)[t.surface] = glm::min((*lo)[t.surface], vertices[v]);
+      (*hi)[t.surface] = glm::max((*hi)[t.surface], vertices[v]);
+    }
+  }
+}
+
 std::vector<double> SceneModel::SurfaceAreas() const {
   std::vector<double> areas(surface_names.size(), 0.0);
   for (const Triangle& t : triangles) {

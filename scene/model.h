@@ -28,6 +28,8 @@ struct SceneModel {
   std::vector<int> MatchSurfaces(const std::string& glob) const;
   // Axis-aligned bounds of all vertices.
   void Bounds(glm::vec3* lo, glm::vec3* hi) const;
+  // The same per surface, over its triangles' vertices (lo > hi for a surface with none).
+  void SurfaceBounds(std::vector<glm::vec3>* lo, std::vector<glm::vec3>* hi) const;
   // Total area in m² of each surface's triangles.
   std::vector<double> SurfaceAreas() const;
 };

@@ -249,13 +249,13 @@ Mesh ObjectMesh(const VirtualObject& object) {
   return mesh;
 }
 
-void CheckObjectsOutsideModel(const std::vector<VirtualObject>& objects, const RayCaster& real, const std::string& where) {
+void CheckObjectsOutsideModel(const SceneModel& objects, const RayCaster& real, const std::string& where) {
   constexpr int kRays = 64;
-  for (size_t o = 0; o < objects.size(); ++o) {
-    const Mesh mesh = ObjectMesh(objects[o]);
-    glm::vec3 lo(1e30f), hi(-1e30f);
-    for (const glm::vec3& p : mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-    const glm::vec3 centre = 0.5f * (lo + hi);
+  std::vector<glm::vec3> lo, hi;
+  objects.SurfaceBounds(&lo, &hi);
+  for (size_t o = 0; o < lo.size(); ++o) {
+    if (lo[o].x > hi[o].x) continue;  // no triangles
+    const glm::vec3 centre = 0.5f * (lo[o] + hi[o]);
     int back = 0;
     std::map<uint32_t, int> surfaces;
     for (int k = 0; k < kRays; ++k) {

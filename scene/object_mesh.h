@@ -38,10 +38,10 @@ Mesh ObjectMesh(const VirtualObject& object);
 bool IsClosedMesh(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices);
 
 // Throws InputError ("<where>: objects[i]: ... inside the model (surface 'x')") for an object
-// whose centre (its mesh's bounding-box centre) lies inside the real model: 9 in 10 of 64 rays
-// from it leave through the back of a face, as from inside a solid wall. `real` is over the
-// scene's model.
-void CheckObjectsOutsideModel(const std::vector<VirtualObject>& objects, const RayCaster& real, const std::string& where);
+// whose centre (its bounding-box centre) lies inside the real model: 9 in 10 of 64 rays from it
+// leave through the back of a face, as from inside a solid wall. `objects` is ObjectsModel's
+// (surface i is object i), `real` a caster over the scene's model.
+void CheckObjectsOutsideModel(const SceneModel& objects, const RayCaster& real, const std::string& where);
 
 // All the objects as one triangle model, surface i being object i (for a RayCaster).
 SceneModel ObjectsModel(const std::vector<VirtualObject>& objects);

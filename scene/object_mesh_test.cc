@@ -128,13 +128,13 @@ TEST(ObjectMeshTest, AnObjectInsideAWallIsRefused) {
   VirtualObject sphere;
   sphere.radius = 0.5;
   sphere.position = glm::dvec3(1.0, 2.0, 0.5);
-  EXPECT_NO_THROW(CheckObjectsOutsideModel({sphere}, caster, "scene.json"));
+  EXPECT_NO_THROW(CheckObjectsOutsideModel(ObjectsModel({sphere}), caster, "scene.json"));
   sphere.position = glm::dvec3(1.0, 2.0, 0.0);  // half in the ground: the ground is a surface, not a solid
-  EXPECT_NO_THROW(CheckObjectsOutsideModel({sphere}, caster, "scene.json"));
+  EXPECT_NO_THROW(CheckObjectsOutsideModel(ObjectsModel({sphere}), caster, "scene.json"));
   VirtualObject inside = sphere;
   inside.position = glm::dvec3(0.5, 0.05, 1.0);
   try {
-    CheckObjectsOutsideModel({sphere, inside}, caster, "scene.json");
+    CheckObjectsOutsideModel(ObjectsModel({sphere, inside}), caster, "scene.json");
     ADD_FAILURE() << "an object inside the wall was accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("scene.json: objects[1]: its centre (0.50, 0.05, 1.00) is inside the model (surface 'wall_north')"),

@@ -7,20 +7,14 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
-#include <filesystem>
-
-#include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
+#include <optional>
 
 #include "render/composite_truth.h"
 #include "render/gl_context.h"
-#include "scene/hdr_image.h"
 #include "tests/courtyard_fixture.h"
 
 namespace daylit::render {
 namespace {
-
-namespace fs = std::filesystem;
 
 TEST(RenderRecordingTest, CompositesMatchThePathTracedFramesWithObjects) {
   std::string why;
@@ -30,22 +24,18 @@ TEST(RenderRecordingTest, CompositesMatchThePathTracedFramesWithObjects) {
   const scene::Scene& scene = c.scene;
   const scene::RayCaster caster(scene.model);
   FrameRenderer renderer(scene, c.bake, caster);
-  const fs::path gt = *scene.groundtruth.composites;
   double worst_object = 0.0, worst_shadow = 0.0, mean_object = 0.0, mean_shadow = 0.0;
   int frames = 0;
   std::vector<float> out;
   for (size_t position = 0; position < scene.frame_times->frames.size(); ++position) {
     const int index = scene.frame_times->frames[position].index;
-    const fs::path with_file = gt / "with_objects" / fmt::format("{:06d}.exr", index);
-    if (!fs::is_regular_file(with_file)) continue;
+    const std::optional<TruthFrame> truth = ReadTruthFrame(scene, index);
+    if (!truth) continue;
     const estimation::FrameFit fit = estimation::FitFrame(scene, c.bake, caster, position, {});
     renderer.Render(fit.frame, fit.fit.light, fit.fit.overcast_share, fit.sun_dir, &out);
-    const scene::HdrImage with = scene::ReadHdrImage(with_file);
-    const scene::HdrImage without = scene::ReadHdrImage(gt / "without_objects" / fmt::format("{:06d}.exr", index));
-    const cv::Mat mask = cv::imread((gt / "objects_mask" / fmt::format("{:06d}.png", index)).string(), cv::IMREAD_GRAYSCALE);
     std::vector<float> linear;
     renderer.Linearize(fit.frame, &linear);
-    const CompositeFidelity f = CompareComposite(out, linear, with.rgb, without.rgb, mask);
+    const CompositeFidelity f = CompareComposite(out, linear, truth->with, truth->without, truth->mask);
     const double object_error = f.object_error, shadow_error = f.shadow_error;
     std::printf("frame %3d: objects %.1f%% over %zu pixels, their shadows %.1f%% over %zu pixels (the video itself %.1f%% off the noise-free frame there)\n", index,
                 100 * object_error, f.object_pixels, 100 * shadow_error, f.shadow_pixels, 100 * f.frame_shadow_error);

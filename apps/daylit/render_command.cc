@@ -5,7 +5,6 @@
 #include <string>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "apps/daylit/commands.h"
 #include "bake/bake.h"
@@ -64,27 +63,18 @@ void RunRender(const RenderOptions& o) {
              fit.fit.light.sun_rgb.x, fit.fit.light.sun_rgb.y, fit.fit.light.sun_rgb.z, fit.fit.light.sky_rgb.x,
              fit.fit.light.sky_rgb.y, fit.fit.light.sky_rgb.z, o.out);
   // Against the path tracer's frame with the objects, when the recording has it.
-  if (!scene.groundtruth.composites) return;
-  const fs::path gt = *scene.groundtruth.composites;
-  const fs::path with_file = gt / "with_objects" / fmt::format("{:06d}.exr", o.frame);
-  const fs::path without_file = gt / "without_objects" / fmt::format("{:06d}.exr", o.frame);
-  const fs::path mask_file = gt / "objects_mask" / fmt::format("{:06d}.png", o.frame);
-  if (!fs::is_regular_file(with_file) || !fs::is_regular_file(without_file) || !fs::is_regular_file(mask_file)) return;
-  const scene::HdrImage with = scene::ReadHdrImage(with_file), without = scene::ReadHdrImage(without_file);
-  const cv::Mat mask = cv::imread(mask_file.string(), cv::IMREAD_GRAYSCALE);
-  if (with.width != w || with.height != h || without.width != w || without.height != h || mask.cols != w || mask.rows != h) {
-    ThrowInputError("{}: the truth frames are not {}x{}", gt.string(), w, h);
-  }
+  const std::optional<render::TruthFrame> truth = render::ReadTruthFrame(scene, o.frame);
+  if (!truth) return;
   std::vector<float> linear;
   renderer.Linearize(fit.frame, &linear);
-  const render::CompositeFidelity f = render::CompareComposite(composite, linear, with.rgb, without.rgb, mask);
+  const render::CompositeFidelity f = render::CompareComposite(composite, linear, truth->with, truth->without, truth->mask);
   fs::path strip = out;
   strip.replace_extension();
   strip += "_vs_truth.png";
-  render::WriteCompositeStrip(strip, w, h, with.rgb, composite, fit.frame.exposure, scene.response);
+  render::WriteCompositeStrip(strip, w, h, truth->with, composite, fit.frame.exposure, scene.response);
   fmt::print("against {}: objects {:.1f}% over {} pixels, their shadows {:.1f}% over {} pixels (the frame itself "
              "{:.1f}% off the truth there)\n",
-             with_file.string(), 100 * f.object_error, f.object_pixels, 100 * f.shadow_error, f.shadow_pixels,
+             truth->with_file.string(), 100 * f.object_error, f.object_pixels, 100 * f.shadow_error, f.shadow_pixels,
              100 * f.frame_shadow_error);
   Log().info("wrote {} (truth | daylit | difference ×4)", strip.string());
 }

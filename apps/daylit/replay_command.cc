@@ -3,7 +3,6 @@
 // video, with the estimates, their plot and a report beside it (docs/render.md).
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
@@ -19,7 +18,6 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "apps/daylit/commands.h"
@@ -37,7 +35,6 @@
 #include "render/gl_context.h"
 #include "render/gl_window.h"
 #include "report/plot.h"
-#include "scene/hdr_image.h"
 #include "scene/scene.h"
 
 namespace daylit::app {
@@ -61,8 +58,8 @@ struct ReplayOptions {
 };
 
 // The window's overlay, drawn into the shown image: frames per second, the sun, and E_sun and
-// E_sky as swatches of their colour with their values.
-void DrawOverlay(cv::Mat* bgr, double fps, const estimation::FrameEstimate& row) {
+// E_sky as swatches of their colour (at full brightness, encoded as the image is) with their values.
+void DrawOverlay(cv::Mat* bgr, double fps, const estimation::FrameEstimate& row, const capture::Encoder& encode) {
   const auto text = [&](const std::string& line, int x, int y) {
     cv::putText(*bgr, line, {x, y}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
     cv::putText(*bgr, line, {x, y}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
@@ -73,53 +70,14 @@ void DrawOverlay(cv::Mat* bgr, double fps, const estimation::FrameEstimate& row)
   for (const bool sun : {true, false}) {
     const glm::dvec3 e = sun ? row.light.sun_rgb : row.light.sky_rgb;
     const double top = std::max({e.x, e.y, e.z, 1e-9});
-    // The light's colour at full brightness, sRGB-encoded.
     cv::Scalar colour;
-    for (int c = 0; c < 3; ++c) {
-      const double v = std::clamp(e[c] / top, 0.0, 1.0);
-      colour[2 - c] = 255.0 * (v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055);
-    }
+    for (int c = 0; c < 3; ++c) colour[2 - c] = 255.0 * encode(static_cast<float>(e[c] / top), c);
     cv::rectangle(*bgr, cv::Rect(12, y, 24, 16), colour, cv::FILLED);
     cv::rectangle(*bgr, cv::Rect(12, y, 24, 16), cv::Scalar(255, 255, 255), 1);
     text(fmt::format("{} {:.3g} {:.3g} {:.3g}", sun ? "E_sun" : "E_sky", e.x, e.y, e.z), 44, y + 13);
     y += 22;
   }
 }
-
-// The path tracer's frames with the objects, where the recording has them (groundtruth/).
-class TruthComposites {
- public:
-  explicit TruthComposites(const scene::Scene& scene) {
-    if (scene.groundtruth.composites) dir_ = *scene.groundtruth.composites;
-  }
-  // The comparison of `composite` with frame `index`'s truth; nullopt where there is none.
-  std::optional<render::CompositeFidelity> Compare(const capture::Frame& frame, const render::FrameRenderer& renderer,
-                                                   const std::vector<float>& composite, std::vector<float>* truth) const {
-    if (dir_.empty()) return std::nullopt;
-    const int index = frame.index, w = renderer.width(), h = renderer.height();
-    const fs::path with_file = dir_ / "with_objects" / fmt::format("{:06d}.exr", index);
-    const fs::path without_file = dir_ / "without_objects" / fmt::format("{:06d}.exr", index);
-    const fs::path mask_file = dir_ / "objects_mask" / fmt::format("{:06d}.png", index);
-    if (!fs::is_regular_file(with_file) || !fs::is_regular_file(without_file) || !fs::is_regular_file(mask_file)) {
-      return std::nullopt;
-    }
-    scene::HdrImage with = scene::ReadHdrImage(with_file);
-    const scene::HdrImage without = scene::ReadHdrImage(without_file);
-    const cv::Mat mask = cv::imread(mask_file.string(), cv::IMREAD_GRAYSCALE);
-    if (with.width != w || with.height != h || without.width != w || without.height != h || mask.cols != w ||
-        mask.rows != h) {
-      ThrowInputError("{}: the truth of frame {} is not {}x{}", dir_.string(), index, w, h);
-    }
-    std::vector<float> linear;
-    renderer.Linearize(frame, &linear);
-    const render::CompositeFidelity f = render::CompareComposite(composite, linear, with.rgb, without.rgb, mask);
-    *truth = std::move(with.rgb);
-    return f;
-  }
-
- private:
-  fs::path dir_;
-};
 
 // Encodes the composites on a thread of its own (the camera's response, then H.264), up to three
 // frames behind the rendering. Write() and Finish() rethrow what went wrong there.
@@ -301,10 +259,9 @@ void RunReplay(const ReplayOptions& o) {
   if (gl) Log().info("rendering with {} ({})", gl->renderer(), gl->platform());
   const int w = renderer.width(), h = renderer.height();
 
-  const TruthComposites truth(scene);
   std::vector<FrameFidelity> fidelity;
   double worst = -1.0;
-  std::vector<float> composite, truth_frame;
+  std::vector<float> composite, linear;
   std::vector<double> render_ms;
   const capture::Encoder to_screen(scene.response);
   cv::Mat shown_rgb(h, w, CV_32FC3), shown;
@@ -326,13 +283,14 @@ void RunReplay(const ReplayOptions& o) {
     if (video) composite = video->TakeBuffer();
     renderer.Render(frame, row.light, overcast_share, sun_dir, &composite);
     render_ms.push_back(1e3 * std::chrono::duration<double>(Clock::now() - t0).count());
-    if (const auto f = truth.Compare(frame, renderer, composite, &truth_frame)) {
-      fidelity.push_back({frame.index, *f});
-      const double score = std::max(f->object_error, f->shadow_error);
+    if (const std::optional<render::TruthFrame> truth = render::ReadTruthFrame(scene, frame.index)) {
+      renderer.Linearize(frame, &linear);
+      const render::CompositeFidelity f = render::CompareComposite(composite, linear, truth->with, truth->without, truth->mask);
+      fidelity.push_back({frame.index, f});
+      const double score = std::max(f.object_error, f.shadow_error);
       if (score > worst) {
         worst = score;
-        render::WriteCompositeStrip(dir / "worst_vs_truth.png", w, h, truth_frame, composite, frame.exposure,
-                                    scene.response);
+        render::WriteCompositeStrip(dir / "worst_vs_truth.png", w, h, truth->with, composite, frame.exposure, scene.response);
       }
     }
     if (window) {
@@ -343,7 +301,7 @@ void RunReplay(const ReplayOptions& o) {
       const double dt = std::chrono::duration<double>(now - last_shown).count();
       shown_fps = shown_fps == 0.0 ? 1.0 / std::max(dt, 1e-3) : 0.9 * shown_fps + 0.1 / std::max(dt, 1e-3);
       last_shown = now;
-      DrawOverlay(&shown, shown_fps, row);
+      DrawOverlay(&shown, shown_fps, row, to_screen);
       if (!window->Show(shown)) g_stop_replay = true;  // closed: end as Ctrl-C does
     }
     if (video) video->Write(std::move(composite), frame.exposure);
