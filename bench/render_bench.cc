@@ -13,6 +13,9 @@
 #include "render/compositor.h"
 #include "render/frame_renderer.h"
 #include "render/gl_context.h"
+#include "render/image_relight_gl.h"
+#include "relight/image_relight.h"
+#include "capture/frame_source.h"
 #include "scene/scene.h"
 
 namespace daylit::render {
@@ -82,6 +85,84 @@ void BM_RendererSetUp(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_RendererSetUp)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+
+// Image relighting (seed 004) at 1280×720: the courtyard's terms for frame 300's sun and a sun
+// three hours on, resampled (nearest) to 1280×720, and a frame in radiance units. Per frame: the
+// ratio E_new / E_now and the modulation, on the CPU (both cores) or in GL (upload the frame,
+// one full-screen pass, read back). Bar: ≥ 30 fps.
+struct Relight720 {
+  relight::RatioTerms terms;
+  std::vector<float> frame;
+  relight::LightParts now, next;
+
+  static const Relight720& Get() {
+    static const Relight720 built = [] {
+      Courtyard& c = Courtyard::Get();
+      relight::ImageRelighter relighter(c.scene, c.bake, *c.caster);
+      const glm::vec3 later = glm::normalize(glm::vec3(-c.fit.sun_dir.y, c.fit.sun_dir.x, c.fit.sun_dir.z));
+      relighter.SetSuns(c.fit.sun_dir, later);
+      const relight::RatioTerms& small = relighter.terms();
+      std::vector<float> linear;
+      capture::LinearRadiance(c.fit.frame, capture::Linearizer(c.scene.response), &linear);
+      Relight720 r;
+      r.terms.width = 1280, r.terms.height = 720;
+      r.terms.now_sun = small.now_sun;
+      const size_t n = 1280 * 720;
+      for (auto* t : {&r.terms.now, &r.terms.next}) t->sun.resize(n), t->clear.resize(n), t->overcast.resize(n);
+      r.terms.kind.resize(n);
+      r.frame.resize(3 * n);
+      for (size_t y = 0; y < 720; ++y) {
+        for (size_t x = 0; x < 1280; ++x) {
+          const size_t p = y * 1280 + x, q = (y * 540 / 720) * 960 + x * 960 / 1280;
+          r.terms.now.sun[p] = small.now.sun[q], r.terms.now.clear[p] = small.now.clear[q];
+          r.terms.now.overcast[p] = small.now.overcast[q], r.terms.next.sun[p] = small.next.sun[q];
+          r.terms.next.clear[p] = small.next.clear[q], r.terms.next.overcast[p] = small.next.overcast[q];
+          r.terms.kind[p] = small.kind[q];
+          for (size_t k = 0; k < 3; ++k) r.frame[3 * p + k] = linear[3 * q + k];
+        }
+      }
+      r.now = relight::SplitLight(c.fit.fit.light, c.fit.fit.overcast_share);
+      r.next = r.now;
+      return r;
+    }();
+    return built;
+  }
+};
+
+void BM_RelightImage720(benchmark::State& state) {
+  const Relight720& r = Relight720::Get();
+  std::vector<float> image;
+  std::unique_ptr<ImageRelightGl> gl;
+  if (state.range(0) == 1) gl = std::make_unique<ImageRelightGl>(1280, 720), gl->SetTerms(r.terms);
+  for (auto _ : state) {
+    image = r.frame;
+    if (gl) {
+      gl->Apply(r.terms, r.now, r.next, image.data());
+    } else {
+      relight::ApplyRatio(r.terms, r.now, r.next, image.data());
+    }
+    benchmark::DoNotOptimize(image.data());
+  }
+  state.SetLabel(state.range(0) == 1 ? "GL (llvmpipe)" : "CPU");
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_RelightImage720)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// A sun move for the image relighter at the courtyard's 960×540: shadow rays for the 400k model
+// pixels and the transfer of their representatives (paths traced already).
+void BM_RelightImageSunMove(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  relight::ImageRelighter relighter(c.scene, c.bake, *c.caster);
+  relighter.SetSuns(c.fit.sun_dir, c.fit.sun_dir);
+  int k = 0;
+  for (auto _ : state) {
+    const float turn = (++k % 2 ? 0.1f : -0.1f) * 0.0175f;
+    const glm::vec3 s = c.fit.sun_dir;
+    const glm::vec3 sun(s.x * std::cos(turn) - s.y * std::sin(turn), s.x * std::sin(turn) + s.y * std::cos(turn), s.z);
+    benchmark::DoNotOptimize(relighter.SetSuns(c.fit.sun_dir, sun));
+  }
+}
+BENCHMARK(BM_RelightImageSunMove)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(4);
 
 }  // namespace
 }  // namespace daylit::render

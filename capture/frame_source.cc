@@ -7,6 +7,8 @@
 #include <ImfArray.h>
 #include <ImfRgbaFile.h>
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -15,6 +17,25 @@
 #include "capture/video_decoder.h"
 
 namespace daylit::capture {
+
+void LinearRadiance(const Frame& frame, const Linearizer& linearizer, std::vector<float>* out) {
+  const size_t n = static_cast<size_t>(frame.rgb.cols) * static_cast<size_t>(frame.rgb.rows) * 3;
+  out->resize(n);
+  const float scale = static_cast<float>(1.0 / frame.exposure);
+  const float* in = frame.rgb.ptr<float>();
+  float* linear = out->data();
+  if (frame.linear) {
+    for (size_t i = 0; i < n; ++i) linear[i] = in[i] * scale;
+    return;
+  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n / 3, 16384), [&](const tbb::blocked_range<size_t>& pixels) {
+    for (size_t i = 3 * pixels.begin(); i < 3 * pixels.end(); i += 3) {
+      linear[i] = linearizer(in[i], 0) * scale;
+      linear[i + 1] = linearizer(in[i + 1], 1) * scale;
+      linear[i + 2] = linearizer(in[i + 2], 2) * scale;
+    }
+  });
+}
 namespace {
 
 // A linear RGB EXR frame as floats (OpenEXR's RGBA interface: any channel layout it knows).

@@ -5,11 +5,13 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "base/utc_time.h"
 #include "capture/frame_times.h"
+#include "capture/response.h"
 
 namespace daylit::capture {
 
@@ -20,6 +22,10 @@ struct Frame {
   cv::Mat rgb;           // CV_32FC3, R, G, B
   bool linear = false;   // true: linear light (EXR); false: encoded by the camera response
 };
+
+// A frame in radiance units, interleaved RGB (width × height × 3): the response's inverse (unless
+// the frame is linear already), then the exposure divided out. On all cores.
+void LinearRadiance(const Frame& frame, const Linearizer& linearizer, std::vector<float>* out);
 
 enum class FrameStatus {
   kFrame,        // `frame` holds the next frame

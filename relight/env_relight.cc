@@ -7,7 +7,6 @@
 #include <glm/gtx/component_wise.hpp>
 #include <opencv2/core.hpp>
 
-#include "bake/surface_light.h"
 #include "report/plot.h"
 #include "scene/latlong.h"
 
@@ -15,42 +14,16 @@ namespace daylit::relight {
 
 EnvRelighter::EnvRelighter(const bake::SceneBake& bake, const glm::vec3& capture_position,
                            const scene::RayCaster& caster, estimation::TransferOptions options)
-    : bake_(bake), caster_(caster),
-      transfer_(bake, estimation::TransferPoints::Env(bake.env), capture_position, caster, options) {
+    : bake_(bake),
+      surface_(bake, estimation::TransferPoints::Env(bake.env), bake.env.width, bake.env.height, true,
+               capture_position, caster, options) {
   const bake::EnvMapMaps& env = bake.env;
-  const int w = env.width, h = env.height;
-  std::vector<uint8_t> chosen(env.surface.size(), 0);
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      const uint32_t t = static_cast<uint32_t>(v) * static_cast<uint32_t>(w) + static_cast<uint32_t>(u);
-      if (env.IsSky(t)) continue;
-      model_texels_.push_back(t);
-      // The nearest corner of its 4×4 block (the map wraps around horizontally) on the same
-      // surface, else the texel itself.
-      const int u0 = u - u % 4, v0 = v - v % 4;
-      uint32_t rep = t;
-      for (const glm::ivec2& c : {glm::ivec2(u0, v0), glm::ivec2(u0 + 4, v0), glm::ivec2(u0, v0 + 4), glm::ivec2(u0 + 4, v0 + 4)}) {
-        if (c.y >= h) continue;
-        const uint32_t ct = static_cast<uint32_t>(c.y) * static_cast<uint32_t>(w) + static_cast<uint32_t>(c.x % w);
-        if (env.surface[ct] == env.surface[t]) {
-          rep = ct;
-          break;
-        }
-      }
-      representative_.push_back(rep);
-      if (!chosen[rep]) chosen[rep] = 1, traced_.push_back(rep);
-    }
-  }
-  std::vector<uint32_t> slot(env.surface.size(), 0);
-  for (size_t k = 0; k < traced_.size(); ++k) slot[traced_[k]] = static_cast<uint32_t>(k);
-  for (uint32_t& rep : representative_) rep = slot[rep];
-  terms_.resize(model_texels_.size());
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      const uint32_t t = static_cast<uint32_t>(v) * static_cast<uint32_t>(w) + static_cast<uint32_t>(u);
+  for (int v = 0; v < env.height; ++v) {
+    for (int u = 0; u < env.width; ++u) {
+      const uint32_t t = static_cast<uint32_t>(v) * static_cast<uint32_t>(env.width) + static_cast<uint32_t>(u);
       if (!env.IsSky(t)) continue;
       sky_texels_.push_back(t);
-      sky_dirs_.push_back(glm::vec3(scene::LatLongDirection(u, v, w, h)));
+      sky_dirs_.push_back(glm::vec3(scene::LatLongDirection(u, v, env.width, env.height)));
     }
   }
 }
@@ -58,31 +31,10 @@ EnvRelighter::EnvRelighter(const bake::SceneBake& bake, const glm::vec3& capture
 bool EnvRelighter::SetSun(const glm::vec3& sun_dir) {
   if (sun_ && glm::degrees(std::acos(std::clamp(glm::dot(*sun_, sun_dir), -1.0f, 1.0f))) <= 0.05f) return false;
   sun_ = sun_dir;
-  const bake::EnvMapMaps& env = bake_.env;
-  // The direct sun at every model texel.
-  std::vector<float> direct(env.surface.size(), 0.0f);
-  bake::DirectSun(caster_, env.point.data(), env.normal.data(), model_texels_, sun_dir, 2e-3f, direct.data());
-  // Transfer of the representatives, then every texel: its own direct terms, its
-  // representative's reflected light (and, for the clear sky, its shape of what V lets through).
-  std::vector<estimation::Transfer> total(traced_.size()), reflected(traced_.size());
-  transfer_.Compute(traced_, sun_dir, direct.data(), total.data(), reflected.data());
-  for (size_t i = 0; i < model_texels_.size(); ++i) {
-    const size_t k = representative_[i];
-    const uint32_t t = model_texels_[i], rep = traced_[k];
-    const estimation::Transfer& r = reflected[k];
-    if (rep == t) {
-      terms_[i] = total[k];
-      continue;
-    }
-    const float v = env.sky_visibility[t], v_rep = env.sky_visibility[rep];
-    const glm::vec3 clear_direct = total[k].clear - r.clear;
-    terms_[i].sun = glm::vec3(direct[t]) + r.sun;
-    terms_[i].overcast = glm::vec3(v) + r.overcast;
-    terms_[i].clear = (v_rep > 0.01f ? clear_direct * (v / v_rep) : glm::vec3(v)) + r.clear;
-  }
+  surface_.Compute(sun_dir, &terms_);
   // The sky's shape per sky texel.
-  const std::vector<glm::vec3> shape = transfer_.ClearSkyPerUnitDhi(sun_dir, sky_dirs_);
-  sky_shape_.assign(env.surface.size(), glm::vec3(0.0f));
+  const std::vector<glm::vec3> shape = surface_.transfer().ClearSkyPerUnitDhi(sun_dir, sky_dirs_);
+  sky_shape_.assign(bake_.env.surface.size(), glm::vec3(0.0f));
   for (size_t i = 0; i < sky_texels_.size(); ++i) sky_shape_[sky_texels_[i]] = shape[i];
   return true;
 }
@@ -101,9 +53,10 @@ void EnvRelighter::Relight(const estimation::SunSky& light, double overcast_shar
   // Sky texels first (model texels overwrite theirs below).
   const glm::vec3 uniform = e.overcast * glm::one_over_pi<float>();
   for (size_t t = 0; t < sky_shape_.size(); ++t) (*radiance)[t] = e.clear * sky_shape_[t] + uniform;
-  for (size_t i = 0; i < model_texels_.size(); ++i) {
+  const std::vector<uint32_t>& model_texels = surface_.model_points();
+  for (size_t i = 0; i < model_texels.size(); ++i) {
     const estimation::Transfer& T = terms_[i];
-    const uint32_t t = model_texels_[i];
+    const uint32_t t = model_texels[i];
     (*radiance)[t] = env.albedo[t] * glm::one_over_pi<float>() * (e.sun * T.sun + e.clear * T.clear + e.overcast * T.overcast);
   }
 }

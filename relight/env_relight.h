@@ -9,9 +9,7 @@
 // the current sun (not a flat colour). The sun itself is not in the map: the renderer draws it
 // as a directional light.
 //
-// When the sun moves, the direct terms are recomputed for every texel (a shadow ray each); the
-// reflected light, which is smooth, comes from the transfer of one texel in 4×4 (the nearest such
-// texel on the same surface; texels with none get their own).
+// When the sun moves, the model texels' terms are recomputed (relight/surface_terms.h).
 #pragma once
 
 #include <filesystem>
@@ -23,6 +21,7 @@
 #include "bake/bake.h"
 #include "estimation/lighting_model.h"
 #include "estimation/transfer.h"
+#include "relight/surface_terms.h"
 #include "scene/hdr_image.h"
 #include "scene/raycaster.h"
 
@@ -63,15 +62,11 @@ class EnvRelighter {
 
  private:
   const bake::SceneBake& bake_;
-  const scene::RayCaster& caster_;
-  estimation::LightTransfer transfer_;
+  SurfaceTerms surface_;
   std::optional<glm::vec3> sun_;
-  std::vector<uint32_t> model_texels_;
-  std::vector<uint32_t> traced_;          // the representatives, each once
-  std::vector<uint32_t> representative_;  // per model texel: its representative, index into traced_
   std::vector<uint32_t> sky_texels_;      // the texels that show sky, and their directions
   std::vector<glm::vec3> sky_dirs_;
-  // Per model texel (in model_texels_ order): the terms.
+  // Per model texel (in surface_.model_points() order): the terms.
   std::vector<estimation::Transfer> terms_;
   // Per texel: the clear sky's radiance per unit DHI (sky texels only).
   std::vector<glm::vec3> sky_shape_;

@@ -18,12 +18,6 @@ namespace {
 
 constexpr float kNear = 0.05f, kFar = 2000.0f;
 
-const char* kFullScreenVertex = R"(#version 330 core
-void main() {
-  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
-  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-})";
-
 // The background texture holds the frame with row 0 at the top; GL's window rows count upward.
 const char* kBackgroundFragment = R"(#version 330 core
 uniform sampler2D background;
@@ -193,7 +187,7 @@ struct Compositor::Gl {
   glm::vec3 shadow_sun{0.0f};
   glm::mat4 shadow_from_world{1.0f};
   float shadow_texel = 0.0f;
-  GlProgram background{kFullScreenVertex, kBackgroundFragment};
+  GlProgram background{kFullScreenTriangle, kBackgroundFragment};
   GlProgram depth{kDepthVertex, kDepthFragment};
   GlProgram object{kObjectVertex, kObjectFragment};
   GlVertexArray empty_vao = NewVertexArray();

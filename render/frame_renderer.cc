@@ -1,7 +1,5 @@
 #include "render/frame_renderer.h"
 
-#include <tbb/parallel_for.h>
-
 #include "base/error.h"
 #include "scene/object_mesh.h"
 
@@ -28,28 +26,17 @@ void FrameRenderer::Linearize(const capture::Frame& frame, std::vector<float>* l
   if (frame.rgb.cols != width() || frame.rgb.rows != height() || frame.rgb.type() != CV_32FC3) {
     ThrowInputError("frame {}: {}x{}, not the camera's {}x{}", frame.index, frame.rgb.cols, frame.rgb.rows, width(), height());
   }
-  // The response's inverse, then the exposure divided out.
-  const size_t n = static_cast<size_t>(width()) * height() * 3;
-  linear->resize(n);
-  const float scale = static_cast<float>(1.0 / frame.exposure);
-  const float* in = frame.rgb.ptr<float>();
-  float* out = linear->data();
-  if (frame.linear) {
-    for (size_t i = 0; i < n; ++i) out[i] = in[i] * scale;
-    return;
-  }
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n / 3, 16384), [&](const tbb::blocked_range<size_t>& pixels) {
-    for (size_t i = 3 * pixels.begin(); i < 3 * pixels.end(); i += 3) {
-      out[i] = linearizer_(in[i], 0) * scale;
-      out[i + 1] = linearizer_(in[i + 1], 1) * scale;
-      out[i + 2] = linearizer_(in[i + 2], 2) * scale;
-    }
-  });
+  capture::LinearRadiance(frame, linearizer_, linear);
 }
 
 void FrameRenderer::Render(const capture::Frame& frame, const estimation::SunSky& light, double overcast_share,
                            const glm::vec3& sun_dir, std::vector<float>* out) {
   Linearize(frame, out);
+  RenderLinear(light, overcast_share, sun_dir, out->data());
+}
+
+void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcast_share, const glm::vec3& sun_dir,
+                                 float* image) {
   CompositeInput input;
   input.light = light;
   input.sun_dir = sun_dir;
@@ -71,8 +58,8 @@ void FrameRenderer::Render(const capture::Frame& frame, const estimation::SunSky
     input.volume = volume_.get();
   }
   shadows_.SetSun(sun_dir);
-  shadows_.Apply(light, overcast_share, out->data());
-  compositor_.Render(input, out->data());
+  shadows_.Apply(light, overcast_share, image);
+  compositor_.Render(input, image);
 }
 
 }  // namespace daylit::render

@@ -31,6 +31,9 @@ class FrameRenderer {
   // The composite of `frame` under `light` (the estimate, filtered or not) and the sun `sun_dir`.
   void Render(const capture::Frame& frame, const estimation::SunSky& light, double overcast_share,
               const glm::vec3& sun_dir, std::vector<float>* out);
+  // The same from the frame linearised already (`image`, width × height × 3, in place): a
+  // relit frame, say (relight::ImageRelighter).
+  void RenderLinear(const estimation::SunSky& light, double overcast_share, const glm::vec3& sun_dir, float* image);
 
   // The frame linearised in radiance units, as Render starts from (for comparisons).
   void Linearize(const capture::Frame& frame, std::vector<float>* linear) const;

@@ -5,6 +5,12 @@
 #include <fmt/format.h>
 
 namespace daylit::render {
+
+const char* const kFullScreenTriangle = R"(#version 330 core
+void main() {
+  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
+  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+})";
 namespace {
 
 // Compile and link errors are the program's own bugs, not bad input: std::logic_error.

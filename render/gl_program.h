@@ -8,6 +8,10 @@
 
 namespace daylit::render {
 
+// A vertex shader that covers the viewport with one triangle (draw 3 vertices, no buffers), for
+// fragment shaders that work per pixel.
+extern const char* const kFullScreenTriangle;
+
 class GlProgram {
  public:
   GlProgram(const char* vertex_source, const char* fragment_source);

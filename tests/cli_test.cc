@@ -481,6 +481,68 @@ TEST(CliTest, ReplayAndRenderWithoutOpenGlSayWhy) {
   fs::remove_all(dir);
 }
 
+// daylit relight: one frame relit to the sun and light of a frame six and a half hours later,
+// compared with it (the bars, also in relight_image_recording_test) with its strip; a
+// range of frames into a video; a sun below the horizon relights with the sky alone.
+TEST(CliTest, RelightWritesTheRelitFrameItsStripAndAVideo) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_relight_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string cache = " --cache " + std::string(DAYLIT_BINARY_DIR) + "/test-cache/courtyard-a";
+  const CliRun like = Daylit("relight " + kRecording + " --frame 152 --like-frame 452 --out " + (dir / "r.png").string() + cache);
+  ASSERT_EQ(like.exit_code, 0) << like.err;
+  double error = 0.0, iou = 0.0;
+  ASSERT_EQ(std::sscanf(like.out.c_str(), "relit frame 152 against frame 452: diffuse pixels %lf%% mean relative error; "
+                                          "shadow layout IoU %lf", &error, &iou), 2) << like.out;
+  EXPECT_LE(error, 10.0);
+  EXPECT_GE(iou, 0.9);
+  const cv::Mat strip = cv::imread((dir / "r_strip.png").string());
+  EXPECT_EQ(strip.cols, 960);
+  EXPECT_EQ(strip.rows, 3 * 540);
+  EXPECT_EQ(cv::imread((dir / "r.png").string()).cols, 960);
+  // The sun 5° below the horizon: sky only, said so; the sunlit frame gets darker everywhere.
+  const CliRun night = Daylit("relight " + kRecording + " --frame 152 --sun-azimuth 300 --sun-elevation -5 --out " +
+                              (dir / "n.exr").string() + cache);
+  ASSERT_EQ(night.exit_code, 0) << night.err;
+  EXPECT_NE(night.err.find("below the horizon; a sky-only relight (E_sun = 0)"), std::string::npos) << night.err;
+  const scene::HdrImage dark = scene::ReadHdrImage(dir / "n.exr");
+  const scene::HdrImage truth = scene::ReadHdrImage(kRecording + "/groundtruth/without_objects/000152.exr");
+  double dark_sum = 0.0, day_sum = 0.0;
+  for (size_t i = 0; i < dark.rgb.size(); ++i) dark_sum += dark.rgb[i], day_sum += truth.rgb[i];
+  EXPECT_LT(dark_sum, 0.5 * day_sum);
+  // Frames 100 to 109 at 18:30 local time, into a video of ten frames; nothing else left behind.
+  const CliRun video = Daylit("relight " + kRecording + " --at 2026-06-21T16:30:00Z --frames 100:109 --sky follow --out " +
+                              (dir / "v.mp4").string() + cache);
+  ASSERT_EQ(video.exit_code, 0) << video.err;
+  EXPECT_NE(video.out.find("10 frames relit to the sun at 2026-06-21T16:30:00Z"), std::string::npos) << video.out;
+  capture::VideoDecoder decoder(dir / "v.mp4");
+  cv::Mat frame;
+  int frames = 0;
+  while (decoder.Next(&frame)) ++frames;
+  EXPECT_EQ(frames, 10);
+  size_t files = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) files += entry.is_regular_file() ? 1 : 0;
+  EXPECT_EQ(files, 4u) << "a temporary file was left behind";
+  fs::remove_all(dir);
+}
+
+// A frame without an estimate (black: no usable pixel) is not relit: the single frame is an
+// error naming it; in a video it is written as it is, and said so.
+TEST(CliTest, RelightOfAFrameWithoutAnEstimate) {
+  bake::testing::SyntheticRecording rec("cli_relight_black");
+  const std::string scene = rec.Write().string();
+  cv::imwrite((rec.dir / "frames" / "000000.png").string(), cv::Mat(48, 64, CV_8UC3, cv::Scalar(0, 0, 0)));
+  const std::string args = "relight " + scene + " --sun-azimuth 180 --sun-elevation 40 --cache " + (rec.dir / "cache").string();
+  const CliRun one = Daylit(args + " --frame 0 --out " + (rec.dir / "r.png").string());
+  EXPECT_EQ(one.exit_code, 2);
+  EXPECT_NE(one.err.find("frame 0: no estimate ("), std::string::npos) << one.err;
+  EXPECT_FALSE(fs::exists(rec.dir / "r.png"));
+  const CliRun video = Daylit(args + " --out " + (rec.dir / "r.mp4").string());
+  ASSERT_EQ(video.exit_code, 0) << video.err;
+  EXPECT_NE(video.err.find("1 frames had no estimate yet (no usable fit) and are written as they are"), std::string::npos)
+      << video.err;
+  EXPECT_TRUE(fs::is_regular_file(rec.dir / "r.mp4"));
+}
+
 TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
   scene::testing::SceneSandbox sandbox("cli");
   sandbox.WriteText("broken.json", "{\"format\": \"daylit-recording/1\",");
@@ -532,6 +594,18 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"replay " + kRecording + " --out /proc/r.mp4", "--out: cannot write /proc/r.mp4"},
       {"replay " + kRecording + " --frames 0", "--frames: 0 is not a number of frames"},
       {"replay " + kRecording + " --screenshot " + dir + "/s.png", "--screenshot: needs --window"},
+      {"relight " + kRecording + " --out " + dir + "/r.mp4",
+       "give the new sun one way: --at, --sun-azimuth with --sun-elevation, or --like-frame"},
+      {"relight " + kRecording + " --at 2026-06-21T10:00:00 --out " + dir + "/r.mp4", "--at: time has no zone"},
+      {"relight " + kRecording + " --sun-azimuth 10 --out " + dir + "/r.mp4", "--sun-azimuth and --sun-elevation go together"},
+      {"relight " + kRecording + " --sun-azimuth 10 --sun-elevation 95 --out " + dir + "/r.mp4", "--sun-elevation: 95 is outside [-90, 90]"},
+      {"relight " + kRecording + " --like-frame 99999 --out " + dir + "/r.mp4", "--like-frame: 99999 is not in"},
+      {"relight " + kRecording + " --like-frame 5 --frame 3 --out " + dir + "/r.mp4", "--out: " + dir + "/r.mp4 must end in .png or .exr"},
+      {"relight " + kRecording + " --like-frame 5 --frames 5 --out " + dir + "/r.mp4", "--frames: '5' is not a:b (frame numbers)"},
+      {"relight " + kRecording + " --like-frame 5 --frames 9:3 --out " + dir + "/r.mp4", "--frames: 9:3 ends before it starts"},
+      {"relight " + kRecording + " --like-frame 5 --sky up --out " + dir + "/r.mp4", "--sky: 'up' is not keep or follow"},
+      {"relight " + kRecording + " --like-frame 5 --e-sun 1,2 --out " + dir + "/r.mp4", "--e-sun: give R,G,B (2 values given)"},
+      {"relight " + kRecording + " --like-frame 5 --out " + dir + "/r.avi", "--out: " + dir + "/r.avi must end in .mp4 or .mkv"},
   };
   for (const BadCall& call : calls) {
     const CliRun run = Daylit(call.args);  // NOLINT

@@ -16,6 +16,7 @@ void AddCalibrateCommands(CLI::App& app);
 void AddRecordCommand(CLI::App& app);
 void AddRenderCommand(CLI::App& app);
 void AddReplayCommand(CLI::App& app);
+void AddRelightCommand(CLI::App& app);
 void AddLiveCommand(CLI::App& app);
 
 }  // namespace daylit::app

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   daylit::app::AddRecordCommand(app);
   daylit::app::AddRenderCommand(app);
   daylit::app::AddReplayCommand(app);
+  daylit::app::AddRelightCommand(app);
   daylit::app::AddLiveCommand(app);
   try {
     app.parse(argc, argv);

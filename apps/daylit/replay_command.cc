@@ -4,13 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
 #include <csignal>
-#include <deque>
-#include <mutex>
-#include <exception>
-#include <thread>
-#include <utility>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -21,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "apps/daylit/commands.h"
+#include "apps/daylit/video_output.h"
 #include "bake/bake.h"
 #include "base/atomic_file.h"
 #include "base/error.h"
@@ -28,7 +23,6 @@
 #include "base/statistics.h"
 #include "capture/frame_source.h"
 #include "capture/response.h"
-#include "capture/video_encoder.h"
 #include "estimation/recording_estimator.h"
 #include "render/composite_truth.h"
 #include "render/frame_renderer.h"
@@ -79,100 +73,6 @@ void DrawOverlay(cv::Mat* bgr, double fps, const estimation::FrameEstimate& row,
   }
 }
 
-// Encodes the composites on a thread of its own (the camera's response, then H.264), up to three
-// frames behind the rendering. Write() and Finish() rethrow what went wrong there.
-class VideoThread {
- public:
-  VideoThread(const fs::path& path, int width, int height, double fps, const capture::CameraResponse& response)
-      : encoder_(path, width, height, capture::VideoEncoderOptions{fps}), to_video_(response), width_(width),
-        height_(height), thread_([this] { Run(); }) {}
-  ~VideoThread() {
-    // Without Finish (an error elsewhere): the queued frames are dropped; the caller removes the file.
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      closing_ = true;
-      items_.clear();
-    }
-    changed_.notify_all();
-    if (thread_.joinable()) thread_.join();
-  }
-
-  // A buffer for the next composite: one the thread has encoded (no allocation), else a new one.
-  std::vector<float> TakeBuffer() {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (spare_.empty()) return {};
-    std::vector<float> buffer = std::move(spare_.back());
-    spare_.pop_back();
-    return buffer;
-  }
-  // A linear composite in radiance units and its exposure; an empty one repeats the last frame.
-  void Write(std::vector<float> composite, double exposure) {
-    Push(Item{std::move(composite), static_cast<float>(exposure), false});
-  }
-  // Encodes what is queued and finishes the file.
-  void Finish() {
-    Push(Item{{}, 0.0f, true});
-    thread_.join();
-    if (error_) std::rethrow_exception(error_);
-    encoder_.Finish();
-  }
-
- private:
-  struct Item {
-    std::vector<float> composite;
-    float exposure = 1.0f;
-    bool last = false;
-  };
-  void Push(Item item) {
-    std::unique_lock<std::mutex> lock(mutex_);
-    changed_.wait(lock, [this] { return items_.size() < 3 || error_ != nullptr; });
-    if (error_) std::rethrow_exception(error_);
-    items_.push_back(std::move(item));
-    changed_.notify_all();
-  }
-  void Run() {
-    cv::Mat encoded = cv::Mat::zeros(height_, width_, CV_32FC3);
-    for (;;) {
-      Item item;
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        changed_.wait(lock, [this] { return !items_.empty() || closing_; });
-        if (items_.empty()) return;
-        item = std::move(items_.front());
-        items_.pop_front();
-      }
-      changed_.notify_all();
-      if (item.last) return;
-      try {
-        if (!item.composite.empty()) {
-          to_video_.Apply(item.composite.data(), item.exposure, encoded.ptr<float>(), item.composite.size());
-        }
-        encoder_.Write(encoded);
-        const std::lock_guard<std::mutex> lock(mutex_);
-        if (!item.composite.empty()) spare_.push_back(std::move(item.composite));
-      } catch (...) {
-        {
-          const std::lock_guard<std::mutex> lock(mutex_);
-          error_ = std::current_exception();
-        }
-        changed_.notify_all();
-        return;
-      }
-    }
-  }
-
-  capture::VideoEncoder encoder_;
-  const capture::Encoder to_video_;
-  const int width_, height_;
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  std::deque<Item> items_;
-  std::vector<std::vector<float>> spare_;  // encoded composites' buffers, for reuse
-  bool closing_ = false;
-  std::exception_ptr error_;
-  std::thread thread_;  // last: starts once the rest is built
-};
-
 struct FrameFidelity {
   int frame = 0;
   render::CompositeFidelity f;
@@ -206,8 +106,7 @@ void PlotFidelity(const std::vector<FrameFidelity>& rows, const std::string& tit
 
 void RunReplay(const ReplayOptions& o) {
   const fs::path out(o.out);
-  const std::string ext = out.extension().string();
-  if (ext != ".mp4" && ext != ".mkv") ThrowInputError("--out: {} must end in .mp4 or .mkv", o.out);
+  CheckVideoName(out);
   if (o.frames && *o.frames < 1) ThrowInputError("--frames: {} is not a number of frames", *o.frames);
   const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
   const scene::Scene scene = scene::LoadScene(o.recording);
@@ -221,23 +120,9 @@ void RunReplay(const ReplayOptions& o) {
   // In a window, a recording plays at its own pace; a camera paces itself.
   if (o.window && scene.frame_times) source = capture::Paced(std::move(source), 1.0);
   const bool write_video = !o.window || o.out_given;
-  if (!fs::is_directory(dir)) ThrowInputError("--out: {}: no such folder", dir.string());
-  fs::path partial = TemporarySibling(out);
-  partial += ext;  // the container is chosen by the extension
-  struct RemoveUnlessCommitted {
-    fs::path path;
-    ~RemoveUnlessCommitted() {
-      std::error_code ec;
-      if (!path.empty()) fs::remove(path, ec);
-    }
-  } cleanup{partial};
-  if (!write_video) cleanup.path.clear();
-  std::optional<VideoThread> video;
-  try {
-    if (write_video) video.emplace(partial, scene.intrinsics.width, scene.intrinsics.height, scene::NominalFps(scene), scene.response);
-  } catch (const InputError& e) {
-    ThrowInputError("--out: cannot write {} ({})", out.string(), e.what());
-  }
+  std::optional<VideoOutput> output;
+  if (write_video) output.emplace(out, scene);
+  capture::AsyncVideoWriter* video = output ? &output->writer() : nullptr;
   // GL: a window's context, or a headless one.
   std::string why;
   std::unique_ptr<render::GlWindow> window;
@@ -309,11 +194,7 @@ void RunReplay(const ReplayOptions& o) {
   std::signal(SIGINT, StopReplay);
   const estimation::EstimateRun run = estimation::EstimateRecording(scene, baked, options, std::move(source));
   std::signal(SIGINT, SIG_DFL);
-  if (video) {
-    video->Finish();
-    CommitTemporary(partial, out);
-    cleanup.path.clear();
-  }
+  if (output) output->Commit();
   if (!o.screenshot.empty()) report::WritePng(o.screenshot, {window->Screenshot()});
 
   const size_t n = run.frames.size();
