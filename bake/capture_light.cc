@@ -7,6 +7,7 @@
 #include <glm/gtx/component_wise.hpp>
 
 #include "base/log.h"
+#include "scene/hdr_image.h"
 #include "scene/latlong.h"
 
 namespace daylit::bake {
@@ -32,7 +33,6 @@ void FillFromNearest(std::vector<glm::dvec3>* values, const std::vector<uint8_t>
   }
 }
 
-float Luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
 
 }  // namespace
 
@@ -60,7 +60,7 @@ CaptureSun ExtractSun(scene::HdrImage* env, const glm::dvec3& sun_dir, const std
     for (int u = 0; u < env->width; ++u) {
       const glm::dvec3 d = scene::LatLongDirection(u, v, env->width, env->height);
       const float* p = env->Pixel(u, v);
-      if (Luminance(p) > brightest) brightest = Luminance(p), brightest_dir = d;
+      if (scene::Luminance(p) > brightest) brightest = scene::Luminance(p), brightest_dir = d;
       const double c = glm::dot(d, glm::dvec3(sun.dir));
       if (c >= cos_disc) {
         disc.push_back(static_cast<size_t>(v) * env->width + u);

@@ -71,7 +71,7 @@ void EnvRelighter::Basis(EnvBasis* basis) const {
 
 namespace {
 
-float Luminance(const glm::vec3& l) { return 0.2126f * l.x + 0.7152f * l.y + 0.0722f * l.z; }
+float Luminance(const glm::vec3& l) { return scene::Luminance(&l.x); }
 
 // The 99th percentile of `luminance` (reordered), the white of a preview.
 float WhiteOf(std::vector<float>& luminance) {

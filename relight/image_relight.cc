@@ -9,6 +9,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "base/statistics.h"
+#include "scene/hdr_image.h"
 
 namespace daylit::relight {
 
@@ -150,16 +151,15 @@ double ShadowIoU(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
 }
 
 double DiffuseError(const bake::CameraGBuffer& g, const float* a, const float* b) {
-  const auto luminance = [](const float* l) { return 0.2126f * l[0] + 0.7152f * l[1] + 0.0722f * l[2]; };
   std::vector<double> lum;
   for (size_t p = 0; p < g.diffuse.size(); ++p) {
-    if (g.diffuse[p]) lum.push_back(luminance(b + 3 * p));
+    if (g.diffuse[p]) lum.push_back(scene::Luminance(b + 3 * p));
   }
   const double floor = 1e-3 * MedianInPlace(lum, 0.0);
   double sum = 0.0;
   size_t count = 0;
   for (size_t p = 0; p < g.diffuse.size(); ++p) {
-    if (!g.diffuse[p] || luminance(b + 3 * p) < floor) continue;
+    if (!g.diffuse[p] || scene::Luminance(b + 3 * p) < floor) continue;
     const float* x = a + 3 * p;
     const float* y = b + 3 * p;
     if (y[0] <= 0.0f || y[1] <= 0.0f || y[2] <= 0.0f) continue;

@@ -9,6 +9,9 @@
 
 namespace daylit::scene {
 
+// Relative luminance of linear Rec.709 RGB (the primaries of every image here).
+inline float Luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
+
 // RGB float image, row-major, row 0 at the top.
 struct HdrImage {
   int width = 0;

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -111,6 +112,11 @@ Scene LoadScene(const std::filesystem::path& path);
 // The scene's frames as a FrameSource: its video or image sequence with frames.csv (exposures
 // falling back to camera.exposure), or its live device.
 std::unique_ptr<capture::FrameSource> OpenFrameSource(const Scene& scene);
+
+// The position in frames.csv of frame number `frame` (as frames.csv names it). Throws InputError
+// "<option>: <frame> is not in <frames.csv>", or "<scene.json>: frames: a live device has no
+// recorded frames".
+size_t FramePosition(const Scene& scene, int frame, std::string_view option);
 
 // The frame rate a video of the scene's frames plays at: a device's `fps`, else one over the
 // median step of frames.csv (a recording may come in bursts; its times stay the truth).

@@ -375,6 +375,15 @@ std::unique_ptr<capture::FrameSource> OpenFrameSource(const Scene& scene) {
   return capture::OpenV4l2Source(scene.frames.device, options);
 }
 
+size_t FramePosition(const Scene& scene, int frame, std::string_view option) {
+  if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
+  const std::vector<capture::FrameTime>& times = scene.frame_times->frames;
+  for (size_t i = 0; i < times.size(); ++i) {
+    if (times[i].index == frame) return i;
+  }
+  ThrowInputError("{}: {} is not in {}", option, frame, scene.frame_times->file.string());
+}
+
 double NominalFps(const Scene& scene) {
   if (scene.frames.kind == FrameSourceKind::kDevice || !scene.frame_times) return scene.frames.fps;
   const std::vector<capture::FrameTime>& times = scene.frame_times->frames;

@@ -61,16 +61,9 @@ struct Target {
   int month = 6;                          // for the clear-sky model
   std::optional<estimation::SunSky> light;  // --like-frame: that frame's estimate
   double overcast_share = 0.0;
+  std::optional<glm::dvec3> e_sun, e_sky;   // --e-sun, --e-sky
   std::string what;                       // for the log
 };
-
-size_t PositionOf(const scene::Scene& scene, int frame, const char* option) {
-  const auto& times = scene.frame_times->frames;
-  for (size_t i = 0; i < times.size(); ++i) {
-    if (times[i].index == frame) return i;
-  }
-  ThrowInputError("{}: {} is not in {}", option, frame, scene.frame_times->file.string());
-}
 
 glm::dvec3 RgbOption(const std::vector<double>& v, const char* option) {
   if (v.size() != 3) ThrowInputError("{}: give R,G,B ({} values given)", option, v.size());
@@ -92,14 +85,10 @@ estimation::SunSky NewLight(const RelightOptions& o, const Target& target, const
     const glm::dvec2 f = relight::ClearSkyFactors(now_elevation_deg, target.elevation_deg, target.month);
     light.sun_rgb *= f.x, light.sky_rgb *= f.y;
   }
-  if (!o.e_sun.empty()) light.sun_rgb = RgbOption(o.e_sun, "--e-sun");
-  if (!o.e_sky.empty()) light.sky_rgb = RgbOption(o.e_sky, "--e-sky");
+  if (target.e_sun) light.sun_rgb = *target.e_sun;
+  if (target.e_sky) light.sky_rgb = *target.e_sky;
   if (target.sun_dir.z <= 0.0f) light.sun_rgb = glm::dvec3(0.0);
   return light;
-}
-
-relight::SceneLight SceneLightOf(const glm::vec3& sun_dir, const estimation::SunSky& light, double overcast) {
-  return {sun_dir, relight::SplitLight(light, overcast)};
 }
 
 // The relit frame's comparison with a real one (--like-frame), printed; the strip beside `out`.
@@ -110,7 +99,7 @@ void CompareWithRealFrame(const scene::Scene& scene, const bake::SceneBake& bake
   std::vector<float> before, after;
   capture::LinearRadiance(original.frame, linearizer, &before);
   capture::LinearRadiance(real.frame, linearizer, &after);
-  const relight::SceneLight light = SceneLightOf(target.sun_dir, *target.light, target.overcast_share);
+  const relight::SceneLight light{target.sun_dir, relight::SplitLight(*target.light, target.overcast_share)};
   const double error = relight::DiffuseError(baked.camera, relit.data(), after.data());
   const std::vector<uint8_t> relit_layout = relight::ShadowLayout(baked.camera, relighter.terms().next, light, relit.data());
   const std::vector<uint8_t> real_layout = relight::ShadowLayout(baked.camera, relighter.terms().next, light, after.data());
@@ -145,12 +134,14 @@ void RunRelight(const RelightOptions& o) {
   if (given != 1) ThrowInputError("give the new sun one way: --at, --sun-azimuth with --sun-elevation, or --like-frame");
   if (o.azimuth.has_value() != o.elevation.has_value()) ThrowInputError("--sun-azimuth and --sun-elevation go together");
   if (o.sky != "keep" && o.sky != "follow") ThrowInputError("--sky: '{}' is not keep or follow", o.sky);
-  if (!o.e_sun.empty()) RgbOption(o.e_sun, "--e-sun");
-  if (!o.e_sky.empty()) RgbOption(o.e_sky, "--e-sky");
+  Target target;
+  if (!o.e_sun.empty()) target.e_sun = RgbOption(o.e_sun, "--e-sun");
+  if (!o.e_sky.empty()) target.e_sky = RgbOption(o.e_sky, "--e-sky");
   const scene::Scene scene = scene::LoadScene(o.recording);
   if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
   // The frames: one, or a range of frame numbers (a:b, both included).
   std::optional<int> first, last;
+  std::optional<size_t> last_position;
   if (!o.frames.empty()) {
     const size_t colon = o.frames.find(':');
     try {
@@ -164,14 +155,13 @@ void RunRelight(const RelightOptions& o) {
       ThrowInputError("--frames: '{}' is not a:b (frame numbers)", o.frames);
     }
     if (*last < *first) ThrowInputError("--frames: {} ends before it starts", o.frames);
-    PositionOf(scene, *first, "--frames");
-    PositionOf(scene, *last, "--frames");
+    scene::FramePosition(scene, *first, "--frames");
+    last_position = scene::FramePosition(scene, *last, "--frames");
   }
-  const size_t position = single ? PositionOf(scene, *o.frame, "--frame") : 0;
+  const size_t position = single ? scene::FramePosition(scene, *o.frame, "--frame") : 0;
 
   // The new sun.
   const sunmodel::SceneGeoFrame geo = scene.GeoFrame();
-  Target target;
   if (!o.at.empty()) {
     const UtcTime utc = ParseUtcTime(o.at, "--at");
     const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(
@@ -203,7 +193,7 @@ void RunRelight(const RelightOptions& o) {
   const scene::RayCaster caster(scene.model);
   std::optional<estimation::FrameFit> like;
   if (o.like_frame) {
-    like = estimation::FitFrame(scene, baked, caster, PositionOf(scene, *o.like_frame, "--like-frame"), {});
+    like = estimation::FitFrame(scene, baked, caster, scene::FramePosition(scene, *o.like_frame, "--like-frame"), {});
     if (!like->fit.IsUsable()) ThrowInputError("--like-frame: frame {} has no estimate ({})", *o.like_frame, like->fit.message);
     target.sun_dir = like->sun_dir;
     target.elevation_deg = like->row.sun_elevation_deg;
@@ -260,7 +250,7 @@ void RunRelight(const RelightOptions& o) {
     estimate.progress_label = "relight";
     g_stop_relight = false;
     estimate.stop = &g_stop_relight;
-    if (last) estimate.max_frames = static_cast<int>(PositionOf(scene, *last, "--frames")) + 1;
+    if (last_position) estimate.max_frames = static_cast<int>(*last_position) + 1;
     int written = 0, unrelit = 0;
     estimate.on_frame = [&](const estimation::FrameEstimate& row, const capture::Frame& frame, const glm::vec3& sun_dir,
                             double overcast_share) {

@@ -27,14 +27,7 @@ struct RelightEnvOptions {
 void RunRelightEnv(const RelightEnvOptions& o) {
   const scene::Scene scene = scene::LoadScene(o.recording);
   if (!scene.envmap) ThrowInputError("{}: envmap: needed to relight it", scene.file.string());
-  if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
-  // --frame names the frame as frames.csv does.
-  const std::vector<capture::FrameTime>& times = scene.frame_times->frames;
-  size_t position = times.size();
-  for (size_t i = 0; i < times.size(); ++i) {
-    if (times[i].index == o.frame) position = i;
-  }
-  if (position == times.size()) ThrowInputError("--frame: {} is not in {}", o.frame, scene.frame_times->file.string());
+  const size_t position = scene::FramePosition(scene, o.frame, "--frame");
   bool loaded = false;
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, bake::CacheDir(scene, o.cache), &loaded);
   const scene::RayCaster caster(scene.model);

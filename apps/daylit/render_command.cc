@@ -36,13 +36,7 @@ void RunRender(const RenderOptions& o) {
   const std::string ext = out.extension().string();
   if (ext != ".png" && ext != ".exr") ThrowInputError("--out: {} must end in .png or .exr", o.out);
   const scene::Scene scene = scene::LoadScene(o.recording);
-  if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
-  const auto& times = scene.frame_times->frames;
-  size_t position = times.size();
-  for (size_t i = 0; i < times.size(); ++i) {
-    if (times[i].index == o.frame) position = i;
-  }
-  if (position == times.size()) ThrowInputError("--frame: {} is not in {}", o.frame, scene.frame_times->file.string());
+  const size_t position = scene::FramePosition(scene, o.frame, "--frame");
   std::string why;
   const auto gl = render::HeadlessGlContext::Create(&why);
   if (gl == nullptr) ThrowInputError("OpenGL: {}", why);
