@@ -16,7 +16,6 @@
 #include "base/log.h"
 #include "scene/latlong.h"
 #include "scene/raycaster.h"
-#include "sunmodel/solar_position.h"
 
 namespace daylit::bake {
 namespace {
@@ -25,11 +24,7 @@ namespace {
 // point is inside closed geometry.
 constexpr double kInsideBackFaceShare = 0.5;
 
-glm::dvec3 SunAtCapture(const scene::Scene& scene) {
-  const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(
-      scene.envmap->time_utc, scene.location, sunmodel::Atmosphere::Standard(scene.location.elevation_m), {});
-  return scene.GeoFrame().DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg);
-}
+glm::dvec3 SunAtCapture(const scene::Scene& scene) { return scene::SunAt(scene, scene.envmap->time_utc).dir; }
 
 void CheckCapturePosition(const scene::Scene& scene, const std::vector<scene::RayHit>& hits) {
   size_t sky = 0, back = 0;

@@ -17,6 +17,7 @@ namespace daylit::render {
 namespace {
 
 constexpr float kNear = 0.05f, kFar = 2000.0f;
+constexpr int kMaxLights = 16;  // as the object shader's
 
 // The background texture holds the frame with row 0 at the top; GL's window rows count upward.
 const char* kBackgroundFragment = R"(#version 330 core
@@ -75,6 +76,16 @@ uniform mat4 shadow_from_world;
 uniform sampler2DShadow shadow_map;
 uniform float shadow_texel;
 uniform bool has_volume;
+// Instead of the volume: directional lights and an ambient term (relight::EnvLights), each light
+// with its own shadow map, a layer of light_maps.
+const int kMaxLights = 16;
+uniform int light_count;
+uniform vec3 ambient;
+uniform vec3 light_dir[kMaxLights];
+uniform vec3 light_rgb[kMaxLights];
+uniform mat4 light_shadow_from_world[kMaxLights];
+uniform float light_texel[kMaxLights];
+uniform sampler2DArrayShadow light_maps;
 out vec4 color;
 const float kPi = 3.14159265358979;
 
@@ -86,6 +97,17 @@ float SunVisibility(vec3 p, vec3 n) {
   vec2 d = vec2(0.5) / vec2(textureSize(shadow_map, 0));
   return 0.25 * (texture(shadow_map, vec3(q.xy + vec2(-d.x, -d.y), q.z)) + texture(shadow_map, vec3(q.xy + vec2(d.x, -d.y), q.z)) +
                  texture(shadow_map, vec3(q.xy + vec2(-d.x, d.y), q.z)) + texture(shadow_map, vec3(q.xy + vec2(d.x, d.y), q.z)));
+}
+
+float LightVisibility(int i, vec3 p, vec3 n) {
+  vec4 s = light_shadow_from_world[i] * vec4(p + n * 4.0 * light_texel[i], 1.0);
+  vec3 q = s.xyz / s.w * 0.5 + 0.5;
+  vec2 d = vec2(0.5) / vec2(textureSize(light_maps, 0).xy);
+  float layer = float(i);
+  return 0.25 * (texture(light_maps, vec4(q.xy + vec2(-d.x, -d.y), layer, q.z)) +
+                 texture(light_maps, vec4(q.xy + vec2(d.x, -d.y), layer, q.z)) +
+                 texture(light_maps, vec4(q.xy + vec2(-d.x, d.y), layer, q.z)) +
+                 texture(light_maps, vec4(q.xy + vec2(d.x, d.y), layer, q.z)));
 }
 
 void main() {
@@ -104,11 +126,52 @@ void main() {
     e += vertex_sh[6] * 0.315392 * (3.0 * z * z - 1.0);
     e += vertex_sh[7] * 1.092548 * x * z;
     e += vertex_sh[8] * 0.546274 * (x * x - y * y);
-    // The bounce from real ground the objects themselves shade (relight::ObjectBounce).
-    e -= sun_rgb * vertex_sun_loss + sky_rgb * vertex_sky_loss;
+  } else if (light_count > 0) {
+    e += ambient;
+    for (int i = 0; i < light_count; ++i) {
+      float c = max(dot(n, light_dir[i]), 0.0);
+      if (c > 0.0) e += light_rgb[i] * c * LightVisibility(i, world_position, n);
+    }
   }
+  // The bounce from real ground the objects themselves shade (relight::ObjectBounce; zero
+  // unless set).
+  e -= sun_rgb * vertex_sun_loss + sky_rgb * vertex_sky_loss;
   color = vec4(albedo / kPi * max(e, vec3(0.0)), 1.0);
 })";
+
+
+// A light's view for its shadow map: orthographic along `dir`, its width over the objects'
+// bounds, its depth over everything that can stand between them and the light.
+struct ShadowView {
+  glm::mat4 shadow_from_world{1.0f};
+  float texel = 0.0f;  // one texel's width in metres
+};
+
+ShadowView ShadowViewOf(const glm::vec3& dir, const glm::vec3& objects_lo, const glm::vec3& objects_hi,
+                        const glm::vec3& model_lo, const glm::vec3& model_hi, int size) {
+  const glm::vec3 centre = 0.5f * (objects_lo + objects_hi);
+  const float radius = 0.5f * glm::length(objects_hi - objects_lo) + 0.05f;
+  float reach = radius;
+  for (int c = 0; c < 8; ++c) {
+    const glm::vec3 corner((c & 1) ? model_hi.x : model_lo.x, (c & 2) ? model_hi.y : model_lo.y, (c & 4) ? model_hi.z : model_lo.z);
+    reach = std::max(reach, glm::dot(corner - centre, dir));
+  }
+  const glm::vec3 up = std::abs(dir.z) < 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
+  const glm::mat4 view = glm::lookAt(centre + (reach + 1.0f) * dir, centre, up);
+  return {glm::ortho(-radius, radius, -radius, radius, 0.0f, reach + radius + 2.0f) * view, 2.0f * radius / static_cast<float>(size)};
+}
+
+// Depth with hardware comparison, lit outside the map.
+void SetShadowSampling(GLenum target) {
+  glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+  glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+  const float lit[] = {1.0f, 1.0f, 1.0f, 1.0f};
+  glTexParameterfv(target, GL_TEXTURE_BORDER_COLOR, lit);
+  glTexParameteri(target, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  glTexParameteri(target, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+}
 
 struct DrawMesh {
   GlVertexArray vao;
@@ -176,6 +239,22 @@ void Draw(const DrawMesh& m) {
   glDrawElements(GL_TRIANGLES, m.count, GL_UNSIGNED_INT, nullptr);
 }
 
+// The depth of `model` (if given) and `objects` seen along `view`, into the bound framebuffer.
+void DrawShadowMap(const GlProgram& depth, const ShadowView& view, int size, const DrawMesh* model,
+                   const std::vector<DrawMesh>& objects) {
+  glViewport(0, 0, size, size);
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  glClear(GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(2.0f, 4.0f);
+  glUseProgram(depth.id());
+  glUniformMatrix4fv(depth.Uniform("clip_from_world"), 1, GL_FALSE, glm::value_ptr(view.shadow_from_world));
+  if (model != nullptr) Draw(*model);
+  for (const DrawMesh& m : objects) Draw(m);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+}
+
 }  // namespace
 
 struct Compositor::Gl {
@@ -198,6 +277,12 @@ struct Compositor::Gl {
   GlFramebuffer msaa = NewFramebuffer(), resolved = NewFramebuffer(), shadow = NewFramebuffer();
   GlRenderbuffer msaa_color = NewRenderbuffer(), msaa_depth = NewRenderbuffer(), resolved_color = NewRenderbuffer();
   GlTexture shadow_map = NewTexture();
+  // The lights' shadow maps (CompositeInput::lights): one layer each, for `light_generation`.
+  GlTexture light_maps = NewTexture();
+  int light_layers = 0;
+  int light_generation = -1;
+  std::vector<glm::mat4> light_shadow_from_world;
+  std::vector<float> light_texel;
   std::vector<float> vertex_sh;  // one mesh's coefficients per vertex
   std::vector<float> readback;
 };
@@ -271,14 +356,7 @@ Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& optio
   glBindTexture(GL_TEXTURE_2D, g.shadow_map.get());
   glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, options.shadow_map_size, options.shadow_map_size, 0,
                GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-  const float lit[] = {1.0f, 1.0f, 1.0f, 1.0f};
-  glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, lit);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  SetShadowSampling(GL_TEXTURE_2D);
   glBindFramebuffer(GL_FRAMEBUFFER, g.shadow.get());
   glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, g.shadow_map.get(), 0);
   glDrawBuffer(GL_NONE);
@@ -318,35 +396,42 @@ void Compositor::Render(const CompositeInput& input, float* image) {
   if (r.width == 0) return;  // no objects in view
   const glm::vec3 sun = glm::normalize(input.sun_dir);
   const bool sun_up = sun.z > 0.0f;
-  // The sun's view: orthographic, its width over the objects' bounds, its depth over everything
-  // that can stand between them and the sun. Redrawn when the sun has moved more than 0.05°.
+  // The sun's shadow map, redrawn when the sun has moved more than 0.05°.
   if (sun_up && (!g.has_shadow_map || glm::dot(sun, g.shadow_sun) < std::cos(glm::radians(0.05f)))) {
     g.has_shadow_map = true;
     g.shadow_sun = sun;
-    const glm::vec3 centre = 0.5f * (g.objects_lo + g.objects_hi);
-    const float radius = 0.5f * glm::length(g.objects_hi - g.objects_lo) + 0.05f;
-    float reach = radius;
-    for (int c = 0; c < 8; ++c) {
-      const glm::vec3 corner((c & 1) ? g.model_hi.x : g.model_lo.x, (c & 2) ? g.model_hi.y : g.model_lo.y,
-                             (c & 4) ? g.model_hi.z : g.model_lo.z);
-      reach = std::max(reach, glm::dot(corner - centre, sun));
-    }
-    const glm::vec3 up = std::abs(sun.z) < 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
-    const glm::mat4 view = glm::lookAt(centre + (reach + 1.0f) * sun, centre, up);
-    g.shadow_from_world = glm::ortho(-radius, radius, -radius, radius, 0.0f, reach + radius + 2.0f) * view;
-    g.shadow_texel = 2.0f * radius / static_cast<float>(g.options.shadow_map_size);
+    const ShadowView view = ShadowViewOf(sun, g.objects_lo, g.objects_hi, g.model_lo, g.model_hi, g.options.shadow_map_size);
+    g.shadow_from_world = view.shadow_from_world;
+    g.shadow_texel = view.texel;
     glBindFramebuffer(GL_FRAMEBUFFER, g.shadow.get());
-    glViewport(0, 0, g.options.shadow_map_size, g.options.shadow_map_size);
-    glEnable(GL_DEPTH_TEST);
-    glDepthMask(GL_TRUE);
-    glClear(GL_DEPTH_BUFFER_BIT);
-    glEnable(GL_POLYGON_OFFSET_FILL);
-    glPolygonOffset(2.0f, 4.0f);
-    glUseProgram(g.depth.id());
-    glUniformMatrix4fv(g.depth.Uniform("clip_from_world"), 1, GL_FALSE, glm::value_ptr(g.shadow_from_world));
-    Draw(g.model);
-    for (const DrawMesh& m : g.objects) Draw(m);
-    glDisable(GL_POLYGON_OFFSET_FILL);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, g.shadow_map.get(), 0);
+    DrawShadowMap(g.depth, view, g.options.shadow_map_size, &g.model, g.objects);
+  }
+  // The lights' shadow maps, redrawn when their directions change. A light that stands for the
+  // real model's reflected light is shadowed by the objects only.
+  const int light_count = input.lights != nullptr ? static_cast<int>(input.lights->lights.size()) : 0;
+  if (light_count > 0 && input.lights_generation != g.light_generation) {
+    if (light_count > kMaxLights) ThrowInputError("Compositor: {} lights; at most {}", light_count, kMaxLights);
+    const int size = g.options.light_shadow_map_size;
+    if (g.light_layers < light_count) {
+      glBindTexture(GL_TEXTURE_2D_ARRAY, g.light_maps.get());
+      glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT24, size, size, light_count, 0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+      SetShadowSampling(GL_TEXTURE_2D_ARRAY);
+      g.light_layers = light_count;
+    }
+    g.light_generation = input.lights_generation;
+    g.light_shadow_from_world.assign(kMaxLights, glm::mat4(1.0f));
+    g.light_texel.assign(kMaxLights, 0.0f);
+    glBindFramebuffer(GL_FRAMEBUFFER, g.shadow.get());
+    for (int i = 0; i < light_count; ++i) {
+      const glm::vec3 dir = glm::normalize(input.lights->lights[i].direction);
+      const ShadowView view = ShadowViewOf(dir, g.objects_lo, g.objects_hi, g.model_lo, g.model_hi, size);
+      g.light_shadow_from_world[i] = view.shadow_from_world;
+      g.light_texel[i] = view.texel;
+      const bool reflected = input.lights_reflected != nullptr && (*input.lights_reflected)[i] != 0;
+      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, g.light_maps.get(), 0, i);
+      DrawShadowMap(g.depth, view, size, reflected ? nullptr : &g.model, g.objects);
+    }
   }
   // The volume's coefficients at every object vertex (trilinear, the corners found once).
   const bool has_volume = input.volume != nullptr;
@@ -411,6 +496,20 @@ void Compositor::Render(const CompositeInput& input, float* image) {
   glBindTexture(GL_TEXTURE_2D, g.shadow_map.get());
   glUniform1i(g.object.Uniform("shadow_map"), 1);
   glUniform1i(g.object.Uniform("has_volume"), has_volume ? 1 : 0);
+  glUniform1i(g.object.Uniform("light_count"), has_volume ? 0 : light_count);
+  if (light_count > 0) {
+    std::vector<glm::vec3> dirs, rgbs;
+    for (const relight::DirectionalLight& l : input.lights->lights) dirs.push_back(glm::normalize(l.direction)), rgbs.push_back(l.irradiance);
+    glUniform3fv(g.object.Uniform("ambient"), 1, glm::value_ptr(input.lights->ambient));
+    glUniform3fv(g.object.Uniform("light_dir"), light_count, glm::value_ptr(dirs[0]));
+    glUniform3fv(g.object.Uniform("light_rgb"), light_count, glm::value_ptr(rgbs[0]));
+    glUniformMatrix4fv(g.object.Uniform("light_shadow_from_world"), light_count, GL_FALSE,
+                       glm::value_ptr(g.light_shadow_from_world[0]));
+    glUniform1fv(g.object.Uniform("light_texel"), light_count, g.light_texel.data());
+  }
+  glActiveTexture(GL_TEXTURE2);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, g.light_maps.get());
+  glUniform1i(g.object.Uniform("light_maps"), 2);
   for (const DrawMesh& m : g.objects) {
     // A closed mesh's back faces are hidden by its front ones: not drawing them halves the work.
     if (m.closed) glEnable(GL_CULL_FACE);

@@ -14,6 +14,7 @@
 // Needs a current GL 3.3 core context (render/gl_context.h).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -21,6 +22,7 @@
 
 #include "estimation/lighting_model.h"
 #include "relight/irradiance_volume.h"
+#include "relight/lights.h"
 #include "scene/scene.h"
 
 namespace daylit::render {
@@ -29,11 +31,18 @@ struct CompositeInput {
   estimation::SunSky light;           // E_sun (DNI) and E_sky, radiance units
   glm::vec3 sun_dir{0.0f, 0.0f, 1.0f};  // unit, toward the sun, scene coordinates
   const relight::IrradianceVolume* volume = nullptr;  // updated for this frame; always the same one; null: no indirect light
+  // Instead of the volume (null), directional lights and an ambient term (relight::EnvLights, at
+  // most 16), each with a shadow map; `lights_reflected` per light: 1 when only the objects shadow
+  // it. Their shadow maps are redrawn when `lights_generation` changes.
+  const relight::LightSet* lights = nullptr;
+  const std::vector<uint8_t>* lights_reflected = nullptr;
+  int lights_generation = 0;
 };
 
 struct CompositorOptions {
   int samples = 4;             // MSAA
   int shadow_map_size = 2048;  // texels over the objects' bounds, seen from the sun
+  int light_shadow_map_size = 1024;  // the same for each of CompositeInput::lights
 };
 
 class Compositor {

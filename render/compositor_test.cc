@@ -156,5 +156,75 @@ TEST(CompositorTest, AnObjectInARealShadowGetsNoSun) {
   EXPECT_GT(f.At(image, camera.Project(facing(*sunlit))).x, 0.3f) << "the sphere in the sun is dark";
 }
 
+// --lighting lights:N: the lights and ambient instead of the volume, each light with its own
+// shadow map. One light along the sun (the sun itself dark): the sphere in a wall's shadow gets
+// the ambient alone, the one in the sun ambient + light·cos; flagged as light the model reflects,
+// the wall no longer blocks it.
+TEST(CompositorTest, LightsCastShadowsUnlessTheModelReflectsThem) {
+  Fixture f(0);
+  const scene::CameraModel camera = f.scene.Camera();
+  const scene::RayCaster real(f.scene.model);
+  std::optional<glm::dvec3> shadowed, sunlit;
+  for (int y = f.scene.intrinsics.height / 2; y < f.scene.intrinsics.height && !(shadowed && sunlit); y += 9) {
+    for (int x = 20; x < f.scene.intrinsics.width - 20 && !(shadowed && sunlit); x += 23) {
+      const glm::dvec3 dir = camera.UnprojectToWorldRay(glm::dvec2(x, y));
+      const scene::RayHit hit = real.Intersect(glm::vec3(camera.CenterInWorld()), glm::vec3(dir));
+      if (!hit.IsHit() || hit.normal.z < 0.9f || hit.t > 20.0f) continue;
+      const glm::dvec3 centre = camera.CenterInWorld() + static_cast<double>(hit.t) * dir + glm::dvec3(0, 0, 0.16);
+      int blocked = 0;
+      for (int k = 0; k < 27; ++k) {
+        const glm::dvec3 q = centre + 0.15 * glm::dvec3(k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1);
+        blocked += real.Occluded(glm::vec3(q), f.sun) ? 1 : 0;
+      }
+      // Apart across the sun's direction, so neither shadows the other.
+      const auto apart = [&](const std::optional<glm::dvec3>& other) {
+        return !other || glm::length(glm::cross(*other - centre, glm::dvec3(f.sun))) > 1.0;
+      };
+      if (blocked == 27 && !shadowed && apart(sunlit)) shadowed = centre;
+      if (blocked == 0 && !sunlit && apart(shadowed)) sunlit = centre;
+    }
+  }
+  ASSERT_TRUE(shadowed && sunlit);
+  scene::Scene s = f.scene;
+  s.objects = {Sphere(*shadowed, 0.15), Sphere(*sunlit, 0.15)};
+  Compositor compositor(s);
+  relight::LightSet lights;
+  lights.ambient = glm::vec3(0.1f, 0.2f, 0.3f);
+  lights.lights = {{f.sun, glm::vec3(10.0f, 20.0f, 30.0f)}};
+  std::vector<uint8_t> reflected = {0};
+  CompositeInput in;
+  in.sun_dir = f.sun;  // E_sun = 0
+  in.lights = &lights;
+  in.lights_reflected = &reflected;
+  in.lights_generation = 1;
+  const auto facing = [&](const glm::dvec3& c) {
+    return c + 0.15 * glm::normalize(glm::normalize(camera.CenterInWorld() - c) + glm::dvec3(f.sun));
+  };
+  // The normal where the pixel's own ray meets the (ideal) sphere: a 0.15 m sphere spans few
+  // pixels, so the normal turns by degrees from one pixel to the next.
+  const auto pixel = [&](const glm::dvec3& c) { return glm::round(camera.Project(facing(c))); };
+  const auto expected = [&](const glm::dvec3& c, bool lit) {
+    const glm::dvec3 o = camera.CenterInWorld(), d = camera.UnprojectToWorldRay(pixel(c));
+    const double b = glm::dot(o - c, d), disc = b * b - (glm::dot(o - c, o - c) - 0.15 * 0.15);
+    EXPECT_GT(disc, 0.0);
+    const glm::dvec3 n = glm::normalize(o + (-b - std::sqrt(std::max(disc, 0.0))) * d - c);
+    const float cos_l = std::max(0.0f, glm::dot(glm::vec3(n), f.sun));
+    return glm::vec3(0.5f / glm::pi<float>()) * (lights.ambient + (lit ? cos_l : 0.0f) * lights.lights[0].irradiance);
+  };
+  const auto check = [&](const glm::vec3& got, const glm::vec3& want, const char* what) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 0.02f * want[c]) << what << " channel " << c;
+  };
+  std::vector<float> image = f.background;
+  compositor.Render(in, image.data());
+  check(f.At(image, pixel(*shadowed)), expected(*shadowed, false), "behind the wall");
+  check(f.At(image, pixel(*sunlit)), expected(*sunlit, true), "in the open");
+  // The same light as one the wall reflects: only the objects shadow it.
+  reflected = {1};
+  in.lights_generation = 2;
+  image = f.background;
+  compositor.Render(in, image.data());
+  check(f.At(image, pixel(*shadowed)), expected(*shadowed, true), "reflected light behind the wall");
+}
+
 }  // namespace
 }  // namespace daylit::render

@@ -6,7 +6,7 @@
 namespace daylit::render {
 
 FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
-                             const CompositorOptions& options)
+                             const FrameRendererOptions& options)
     : scene_(scene),
       caster_(caster),
       objects_model_(scene::ObjectsModel(scene.objects)),
@@ -14,12 +14,32 @@ FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& b
       shadows_(scene, bake, caster, objects_),
       bounce_(scene, bake, caster, objects_),
       relighter_(bake, scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f), caster),
-      compositor_(scene, options),
+      compositor_(scene, options.compositor),
       linearizer_(scene.response) {
   scene::CheckObjectsOutsideModel(objects_model_, caster, scene.file.string());
   if (!bake.gather.directions.empty()) {
     volume_ = std::make_unique<relight::IrradianceVolume>(bake.gather, relight::ProbesInsideModel(bake.gather, caster));
   }
+  if (options.lights > 0 && !scene.objects.empty()) {
+    if (!scene.envmap) ThrowInputError("{}: --lighting lights:{} needs the scene's envmap", scene.file.string(), options.lights);
+    glm::vec3 lo, hi;
+    objects_model_.Bounds(&lo, &hi);
+    env_lights_ = std::make_unique<relight::EnvLights>(options.lights, caster, 0.5f * (lo + hi),
+                                                       glm::vec3(scene.envmap->position), bake.env.width, bake.env.height);
+  }
+}
+
+int ParseLighting(const std::string& text, const char* where) {
+  if (text == "volume") return 0;
+  if (text.rfind("lights:", 0) == 0) {
+    const std::string n = text.substr(7);
+    if (!n.empty() && n.size() <= 3 && n.find_first_not_of("0123456789") == std::string::npos) {
+      const int count = std::stoi(n);
+      if (count >= 1 && count <= relight::EnvLights::kMaxLights) return count;
+      ThrowInputError("{}: {} lights; give 1 to {}", where, count, relight::EnvLights::kMaxLights);
+    }
+  }
+  ThrowInputError("{}: '{}' is not volume or lights:N", where, text);
 }
 
 void FrameRenderer::Linearize(const capture::Frame& frame, std::vector<float>* linear) const {
@@ -40,8 +60,22 @@ void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcas
   CompositeInput input;
   input.light = light;
   input.sun_dir = sun_dir;
-  if (volume_) {
+  const relight::LightParts e = relight::SplitLight(light, overcast_share);
+  if (volume_ || env_lights_) {
     if (bounce_.SetSun(sun_dir)) compositor_.SetObjectLosses(bounce_.sun_loss(), bounce_.sky_loss());
+  }
+  if (env_lights_) {
+    // The relit map's lights: fitted when the sun moves or the light changes much, else each
+    // part's irradiances combined.
+    if (relighter_.SetSun(sun_dir)) {
+      relighter_.Basis(&basis_);
+      shadows_.SetEnvBasis(basis_);
+      env_lights_->SetBasis(basis_);
+    }
+    input.lights = &env_lights_->Update(e);
+    input.lights_reflected = &env_lights_->reflected();
+    input.lights_generation = env_lights_->generation();
+  } else if (volume_) {
     // The relit map is linear in E_sun, E_clear and E_overcast, and so is the volume: the three
     // parts are recomputed when the sun moves, and each frame only combines them.
     if (relighter_.SetSun(sun_dir)) {
@@ -53,7 +87,6 @@ void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcas
         volume_parts_[i] = volume_->coefficients();
       }
     }
-    const relight::LightParts e = relight::SplitLight(light, overcast_share);
     volume_->SetCombination({&volume_parts_[0], &volume_parts_[1], &volume_parts_[2]}, {e.sun, e.clear, e.overcast});
     input.volume = volume_.get();
   }

@@ -8,11 +8,13 @@
 
 #include <array>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "bake/bake.h"
 #include "estimation/recording_estimator.h"
 #include "render/compositor.h"
+#include "relight/env_lights.h"
 #include "relight/env_relight.h"
 #include "relight/irradiance_volume.h"
 #include "relight/object_bounce.h"
@@ -22,11 +24,22 @@
 
 namespace daylit::render {
 
+struct FrameRendererOptions {
+  CompositorOptions compositor;
+  // 0: the objects' light besides the sun is the irradiance volume. N > 0: N directional lights
+  // and an ambient term fitted to the relit env map (relight::EnvLights), each casting shadows
+  // (daylit render/replay --lighting lights:N).
+  int lights = 0;
+};
+
+// "volume" → 0, "lights:N" → N (1..16); InputError "<where>: ..." otherwise.
+int ParseLighting(const std::string& text, const char* where);
+
 class FrameRenderer {
  public:
   // `caster` is over the scene's model; the renderer keeps references to all three.
   FrameRenderer(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
-                const CompositorOptions& options = {});
+                const FrameRendererOptions& options = {});
 
   // The composite of `frame` under `light` (the estimate, filtered or not) and the sun `sun_dir`.
   void Render(const capture::Frame& frame, const estimation::SunSky& light, double overcast_share,
@@ -38,6 +51,8 @@ class FrameRenderer {
   // The frame linearised in radiance units, as Render starts from (for comparisons).
   void Linearize(const capture::Frame& frame, std::vector<float>* linear) const;
   const relight::ObjectShadows& shadows() const { return shadows_; }
+  // With --lighting lights:N, the lights (null otherwise).
+  const relight::EnvLights* env_lights() const { return env_lights_.get(); }
   int width() const { return compositor_.width(); }
   int height() const { return compositor_.height(); }
 
@@ -54,6 +69,7 @@ class FrameRenderer {
   capture::Linearizer linearizer_;
   relight::EnvBasis basis_;
   std::array<std::vector<float>, 3> volume_parts_;  // the volume per unit E_sun, E_clear, E_overcast
+  std::unique_ptr<relight::EnvLights> env_lights_;  // --lighting lights:N
 };
 
 }  // namespace daylit::render

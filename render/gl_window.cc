@@ -36,6 +36,7 @@ struct GlWindow::State {
   GlTexture texture;
   GlVertexArray vao;
   int image_width = 0, image_height = 0;
+  std::vector<WindowKey> keys;  // since the last TakeInput
 
   ~State() {
     // GL objects go while the context is still there.
@@ -71,6 +72,19 @@ std::unique_ptr<GlWindow> GlWindow::Create(int width, int height, const std::str
     *why = std::string("no GL 3.3 core window (") + (description != nullptr ? description : "unknown") + ")";
     return nullptr;
   }
+  glfwSetWindowUserPointer(s.window, &s);
+  glfwSetKeyCallback(s.window, [](GLFWwindow* window, int key, int /*scancode*/, int action, int /*mods*/) {
+    if (action == GLFW_RELEASE) return;
+    auto* state = static_cast<State*>(glfwGetWindowUserPointer(window));
+    switch (key) {
+      case GLFW_KEY_LEFT: state->keys.push_back(WindowKey::kLeft); break;
+      case GLFW_KEY_RIGHT: state->keys.push_back(WindowKey::kRight); break;
+      case GLFW_KEY_UP: state->keys.push_back(WindowKey::kUp); break;
+      case GLFW_KEY_DOWN: state->keys.push_back(WindowKey::kDown); break;
+      case GLFW_KEY_BACKSPACE: state->keys.push_back(WindowKey::kBackspace); break;
+      default: break;
+    }
+  });
   glfwMakeContextCurrent(s.window);
   glfwSwapInterval(0);  // the replay paces itself
   s.program = std::make_unique<GlProgram>(kVertex, kFragment);
@@ -105,6 +119,21 @@ bool GlWindow::Show(const cv::Mat& bgr) {
   Draw();
   glfwSwapBuffers(s.window);
   return true;
+}
+
+WindowInput GlWindow::TakeInput() {
+  State& s = *state_;
+  WindowInput input;
+  input.keys.swap(s.keys);
+  if (glfwGetMouseButton(s.window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
+    // The cursor is in the window's screen coordinates; the image is stretched over the window.
+    double x = 0.0, y = 0.0;
+    int w = 0, h = 0;
+    glfwGetCursorPos(s.window, &x, &y);
+    glfwGetWindowSize(s.window, &w, &h);
+    if (w > 0 && h > 0) input.dragging = cv::Point2d(x * s.image_width / w, y * s.image_height / h);
+  }
+  return input;
 }
 
 void GlWindow::Draw() const {

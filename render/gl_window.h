@@ -4,11 +4,20 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
 namespace daylit::render {
+
+// What the user did in the window since it was last asked.
+enum class WindowKey { kLeft, kRight, kUp, kDown, kBackspace };
+struct WindowInput {
+  std::vector<WindowKey> keys;          // presses and auto-repeats, in order
+  std::optional<cv::Point2d> dragging;  // the cursor while the left button is down, in image pixels
+};
 
 class GlWindow {
  public:
@@ -22,6 +31,8 @@ class GlWindow {
   // Shows an 8-bit BGR image and handles the window's events. Returns false once the user has
   // closed the window (or pressed Esc or Q).
   bool Show(const cv::Mat& bgr);
+  // The keys pressed since the last call, and the cursor if the left button is down now.
+  WindowInput TakeInput();
   // What the window shows now, 8-bit BGR at the window's size.
   cv::Mat Screenshot() const;
 

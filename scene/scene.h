@@ -105,6 +105,14 @@ struct Scene {
   sunmodel::SceneGeoFrame GeoFrame() const { return {location, north_azimuth_deg}; }
 };
 
+// The sun at `utc` over the scene's site (standard atmosphere at the site's height): its position
+// and its unit direction in scene coordinates.
+struct SceneSun {
+  sunmodel::SunPosition position;
+  glm::dvec3 dir{0.0, 0.0, 1.0};
+};
+SceneSun SunAt(const Scene& scene, const UtcTime& utc);
+
 // Loads `path` (a scene.json, or a recording folder holding one), the OBJ model it names and
 // its frames.csv, and checks every field. Throws InputError "<file>: <field>: <problem>".
 Scene LoadScene(const std::filesystem::path& path);

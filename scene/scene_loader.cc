@@ -375,6 +375,14 @@ std::unique_ptr<capture::FrameSource> OpenFrameSource(const Scene& scene) {
   return capture::OpenV4l2Source(scene.frames.device, options);
 }
 
+SceneSun SunAt(const Scene& scene, const UtcTime& utc) {
+  SceneSun sun;
+  sun.position = sunmodel::ComputeSunPosition(utc, scene.location,
+                                              sunmodel::Atmosphere::Standard(scene.location.elevation_m), {});
+  sun.dir = scene.GeoFrame().DirectionInScene(sun.position.azimuth_deg, sun.position.apparent_zenith_deg);
+  return sun;
+}
+
 size_t FramePosition(const Scene& scene, int frame, std::string_view option) {
   if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
   const std::vector<capture::FrameTime>& times = scene.frame_times->frames;

@@ -371,9 +371,15 @@ TEST(CliTest, RenderWritesTheCompositeAndComparesItWithTheTruth) {
     }
   }
   EXPECT_NEAR(ratio / n, 1.0, 0.03);
-  const CliRun png =
-      Daylit("render " + kRecording + " --frame 300 --cache " + cache + " --out " + (dir / "f.png").string(), kGlEnvironment);
+  // The PNG, with the objects lit by the sun and 8 lights fitted to the relit map instead of the
+  // volume: as close to the truth on the objects.
+  const CliRun png = Daylit("render " + kRecording + " --frame 300 --lighting lights:8 --cache " + cache + " --out " +
+                                (dir / "f.png").string(), kGlEnvironment);
   ASSERT_EQ(png.exit_code, 0) << png.err;
+  EXPECT_NE(png.err.find("the objects lit by the sun and 8 lights fitted to the relit env map"), std::string::npos) << png.err;
+  const size_t at = png.out.find(": objects ");
+  ASSERT_NE(at, std::string::npos) << png.out;
+  EXPECT_LT(std::stod(png.out.substr(at + 10)), 6.0) << png.out;
   const cv::Mat encoded = cv::imread((dir / "f.png").string());
   EXPECT_EQ(encoded.cols, image.width);
   fs::remove_all(dir);
@@ -459,6 +465,44 @@ TEST(CliTest, ReplayInAWindowShowsTheComposite) {
   EXPECT_GT(cv::countNonZero(overlay), 200) << "no overlay text";
   // With --out as well, the video is written too.
   EXPECT_TRUE(fs::is_regular_file(dir / "w.mp4"));
+  fs::remove_all(dir);
+}
+
+// The window's time slider, started at 16:30 UTC (--relight-at; the arrows and the bar move it):
+// frame 0 (07:00 local) is shown as daylit relight makes it for that time, objects included,
+// with the slider's knob on the bar.
+TEST(CliTest, TheWindowsTimeSliderRelightsTheFrames) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_slider_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string cache = " --cache " + std::string(DAYLIT_BINARY_DIR) + "/test-cache/courtyard-a";
+  const CliRun shown = Daylit("replay " + kRecording + " --window --frames 1 --relight-at 16:30 --screenshot " +
+                                  (dir / "shot.png").string() + cache,
+                              kGlEnvironment + "xvfb-run -a -s '-screen 0 1280x1024x24' ");
+  ASSERT_EQ(shown.exit_code, 0) << shown.err;
+  const CliRun relit = Daylit("relight " + kRecording + " --frame 0 --at 2026-06-21T16:30:00Z --objects --out " +
+                                  (dir / "relit.png").string() + cache,
+                              kGlEnvironment);
+  ASSERT_EQ(relit.exit_code, 0) << relit.err;
+  const cv::Mat shot = cv::imread((dir / "shot.png").string());
+  const cv::Mat expected = cv::imread((dir / "relit.png").string());
+  ASSERT_EQ(shot.size(), expected.size());
+  // Between the overlay's text and the slider.
+  const cv::Rect middle(0, 90, shot.cols, 380);
+  cv::Mat difference;
+  cv::absdiff(shot(middle), expected(middle), difference);
+  EXPECT_LT(cv::mean(difference)[0], 1.5) << "the window's relit frame is not daylit relight's";
+  // And it is not the frame as recorded: the morning's shadows and light are gone.
+  capture::VideoDecoder original(kRecording + "/video.mp4");
+  cv::Mat frame, recorded;
+  ASSERT_TRUE(original.Next(&frame));
+  frame.convertTo(recorded, CV_8UC3, 255.0);
+  cv::cvtColor(recorded, recorded, cv::COLOR_RGB2BGR);
+  cv::absdiff(shot(middle), recorded(middle), difference);
+  EXPECT_GT(cv::mean(difference)[0], 8.0) << "the window shows the frame unrelit";
+  // The knob (orange) on the bar along the bottom.
+  cv::Mat knob;
+  cv::inRange(shot(cv::Rect(0, shot.rows - 40, shot.cols, 40)), cv::Scalar(0, 190, 245), cv::Scalar(10, 210, 255), knob);
+  EXPECT_GT(cv::countNonZero(knob), 40) << "no slider knob";
   fs::remove_all(dir);
 }
 
@@ -594,6 +638,11 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"replay " + kRecording + " --out /proc/r.mp4", "--out: cannot write /proc/r.mp4"},
       {"replay " + kRecording + " --frames 0", "--frames: 0 is not a number of frames"},
       {"replay " + kRecording + " --screenshot " + dir + "/s.png", "--screenshot: needs --window"},
+      {"replay " + kRecording + " --relight-at 18:30", "--relight-at: needs --window"},
+      {"replay " + kRecording + " --lighting lights:0", "--lighting: 0 lights; give 1 to 16"},
+      {"render " + kRecording + " --frame 300 --lighting lights:99 --out " + dir + "/f.png", "--lighting: 99 lights; give 1 to 16"},
+      {"render " + kRecording + " --frame 300 --lighting sun --out " + dir + "/f.png", "--lighting: 'sun' is not volume or lights:N"},
+      {"replay " + kRecording + " --window --relight-at 25:00", "--relight-at: '25:00' is not a UTC time of day HH:MM"},
       {"relight " + kRecording + " --out " + dir + "/r.mp4",
        "give the new sun one way: --at, --sun-azimuth with --sun-elevation, or --like-frame"},
       {"relight " + kRecording + " --at 2026-06-21T10:00:00 --out " + dir + "/r.mp4", "--at: time has no zone"},

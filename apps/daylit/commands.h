@@ -2,6 +2,8 @@
 // writes results to stdout or files and throws InputError for bad input (exit code 2).
 #pragma once
 
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 namespace daylit::app {
@@ -18,5 +20,8 @@ void AddRenderCommand(CLI::App& app);
 void AddReplayCommand(CLI::App& app);
 void AddRelightCommand(CLI::App& app);
 void AddLiveCommand(CLI::App& app);
+
+// --lighting volume|lights:N, for the commands that render the objects (render::ParseLighting).
+void AddLightingOption(CLI::App* cmd, std::string* lighting);
 
 }  // namespace daylit::app

@@ -31,9 +31,9 @@ std::string Duration(double seconds) {
 }
 
 std::string SunLine(const scene::Scene& scene, const UtcTime& utc) {
-  const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(
-      utc, scene.location, sunmodel::Atmosphere::Standard(scene.location.elevation_m), {});
-  const glm::dvec3 d = scene.GeoFrame().DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg);
+  const scene::SceneSun at = scene::SunAt(scene, utc);
+  const sunmodel::SunPosition& sun = at.position;
+  const glm::dvec3& d = at.dir;
   return fmt::format("{}  elevation {:7.3f}  azimuth {:7.3f}  scene ({:+.4f}, {:+.4f}, {:+.4f}){}",
                      FormatUtcTime(utc, 1), sun.ApparentElevationDeg(), sun.azimuth_deg, d.x, d.y,
                      d.z, sun.AboveHorizon() ? "" : "  below the horizon");

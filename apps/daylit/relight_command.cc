@@ -164,9 +164,9 @@ void RunRelight(const RelightOptions& o) {
   const sunmodel::SceneGeoFrame geo = scene.GeoFrame();
   if (!o.at.empty()) {
     const UtcTime utc = ParseUtcTime(o.at, "--at");
-    const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(
-        utc, scene.location, sunmodel::Atmosphere::Standard(scene.location.elevation_m), {});
-    target.sun_dir = glm::vec3(geo.DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg));
+    const scene::SceneSun at = scene::SunAt(scene, utc);
+    const sunmodel::SunPosition& sun = at.position;
+    target.sun_dir = glm::vec3(at.dir);
     target.elevation_deg = sun.ApparentElevationDeg();
     target.month = utc.month;
     target.what = fmt::format("the sun at {} ({:.1f}° up, azimuth {:.1f}°)", o.at, target.elevation_deg, sun.azimuth_deg);

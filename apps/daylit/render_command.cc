@@ -29,6 +29,7 @@ struct RenderOptions {
   std::string cache;
   int frame = 0;
   std::string out = "frame.png";
+  std::string lighting = "volume";
 };
 
 void RunRender(const RenderOptions& o) {
@@ -37,6 +38,8 @@ void RunRender(const RenderOptions& o) {
   if (ext != ".png" && ext != ".exr") ThrowInputError("--out: {} must end in .png or .exr", o.out);
   const scene::Scene scene = scene::LoadScene(o.recording);
   const size_t position = scene::FramePosition(scene, o.frame, "--frame");
+  render::FrameRendererOptions options;
+  options.lights = render::ParseLighting(o.lighting, "--lighting");
   std::string why;
   const auto gl = render::HeadlessGlContext::Create(&why);
   if (gl == nullptr) ThrowInputError("OpenGL: {}", why);
@@ -44,7 +47,7 @@ void RunRender(const RenderOptions& o) {
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, bake::CacheDir(scene, o.cache), &loaded);
   const scene::RayCaster caster(scene.model);
   const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, position, {});
-  render::FrameRenderer renderer(scene, baked, caster);
+  render::FrameRenderer renderer(scene, baked, caster, options);
   std::vector<float> composite;
   renderer.Render(fit.frame, fit.fit.light, fit.fit.overcast_share, fit.sun_dir, &composite);
   const int w = renderer.width(), h = renderer.height();
@@ -52,6 +55,10 @@ void RunRender(const RenderOptions& o) {
     scene::WriteRgbExr(out, w, h, composite.data());
   } else {
     report::WritePng(out, {capture::EncodeToBgr8(composite.data(), w, h, fit.frame.exposure, &scene.response)});
+  }
+  if (const relight::EnvLights* lights = renderer.env_lights()) {
+    Log().info("the objects lit by the sun and {} lights fitted to the relit env map ({:.1f}% off its irradiance)",
+               lights->count(), 100 * lights->error());
   }
   Log().info("frame {}: E_sun ({:.3g}, {:.3g}, {:.3g}), E_sky ({:.3g}, {:.3g}, {:.3g}); wrote {}", o.frame,
              fit.fit.light.sun_rgb.x, fit.fit.light.sun_rgb.y, fit.fit.light.sun_rgb.z, fit.fit.light.sky_rgb.x,
@@ -75,6 +82,12 @@ void RunRender(const RenderOptions& o) {
 
 }  // namespace
 
+void AddLightingOption(CLI::App* cmd, std::string* lighting) {
+  cmd->add_option("--lighting", *lighting,
+                  "The objects' light besides the sun: volume (the irradiance volume, the default) or lights:N, "
+                  "N directional lights (1 to 16) fitted to the relit env map, each casting shadows");
+}
+
 void AddRenderCommand(CLI::App& app) {
   auto options = std::make_shared<RenderOptions>();
   CLI::App* cmd = app.add_subcommand("render", "One frame with the scene's virtual objects, lit and shadowed like it");
@@ -85,6 +98,7 @@ void AddRenderCommand(CLI::App& app) {
   cmd->add_option("--frame", options->frame, "Frame number, as in frames.csv")->required();
   cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
   cmd->add_option("--out", options->out, "Output .png or .exr (default frame.png)");
+  AddLightingOption(cmd, &options->lighting);
   cmd->callback([options] { RunRender(*options); });
 }
 

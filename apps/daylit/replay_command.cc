@@ -28,6 +28,8 @@
 #include "render/frame_renderer.h"
 #include "render/gl_context.h"
 #include "render/gl_window.h"
+#include "relight/image_relight.h"
+#include "relight/time_slider.h"
 #include "report/plot.h"
 #include "scene/scene.h"
 
@@ -49,6 +51,8 @@ struct ReplayOptions {
   std::optional<int> frames;
   bool window = false;
   std::string screenshot;
+  std::string relight_at;  // the time slider's start, HH:MM UTC
+  std::string lighting = "volume";
 };
 
 // The window's overlay, drawn into the shown image: frames per second, the sun, and E_sun and
@@ -71,6 +75,81 @@ void DrawOverlay(cv::Mat* bgr, double fps, const estimation::FrameEstimate& row,
     text(fmt::format("{} {:.3g} {:.3g} {:.3g}", sun ? "E_sun" : "E_sky", e.x, e.y, e.z), 44, y + 13);
     y += 22;
   }
+}
+
+// The window's time slider: a bar along the bottom over the site's solar day.
+struct SliderBar {
+  int x0, x1, y, height;
+  static SliderBar Of(int width, int height) { return {16, width - 16, height - 22, 10}; }
+  bool Hit(const cv::Point2d& p) const { return p.y >= y - 14 && p.y <= y + height + 14 && p.x >= x0 - 8 && p.x <= x1 + 8; }
+  int X(double fraction) const { return x0 + static_cast<int>(std::lround(fraction * (x1 - x0))); }
+};
+
+// Arrow keys move the slider by 15 min (left, right) or an hour (down, up); Backspace turns it off
+// (the frame's own time); a click or drag on the bar puts it there.
+void ApplyInput(const render::WindowInput& input, const UtcTime& frame_utc, const SliderBar& bar, relight::TimeSlider* slider) {
+  for (const render::WindowKey key : input.keys) {
+    switch (key) {
+      case render::WindowKey::kLeft: slider->Step(-15, frame_utc); break;
+      case render::WindowKey::kRight: slider->Step(15, frame_utc); break;
+      case render::WindowKey::kDown: slider->Step(-60, frame_utc); break;
+      case render::WindowKey::kUp: slider->Step(60, frame_utc); break;
+      case render::WindowKey::kBackspace: slider->Off(); break;
+    }
+  }
+  if (input.dragging && bar.Hit(*input.dragging)) {
+    slider->SetFraction((input.dragging->x - bar.x0) / static_cast<double>(bar.x1 - bar.x0));
+  }
+}
+
+// Where the sun is up over one solar day, sampled every 10 minutes, for shading the bar's night.
+struct SunlitDay {
+  double midnight = -1.0;  // the day's start, Unix seconds
+  std::vector<bool> up;
+};
+
+void DrawTimeSlider(cv::Mat* bgr, const relight::TimeSlider& slider, const scene::Scene& scene, const UtcTime& frame_utc,
+                    const std::optional<scene::SceneSun>& relit_sun, SunlitDay* day) {
+  const SliderBar bar = SliderBar::Of(bgr->cols, bgr->rows);
+  const double midnight = UnixSeconds(slider.AtFraction(frame_utc, 0.0));
+  if (std::abs(midnight - day->midnight) > 1.0) {
+    day->midnight = midnight;
+    day->up.assign(144, false);
+    for (int i = 0; i < 144; ++i) {
+      day->up[i] = scene::SunAt(scene, UtcFromUnixSeconds(midnight + 600.0 * (i + 0.5))).dir.z > 0.0;
+    }
+  }
+  for (int i = 0; i < 144; ++i) {
+    const cv::Scalar colour = day->up[i] ? cv::Scalar(150, 200, 230) : cv::Scalar(90, 40, 30);
+    cv::rectangle(*bgr, cv::Point(bar.X(i / 144.0), bar.y), cv::Point(bar.X((i + 1) / 144.0), bar.y + bar.height), colour,
+                  cv::FILLED);
+  }
+  cv::rectangle(*bgr, cv::Rect(bar.x0, bar.y, bar.x1 - bar.x0, bar.height), cv::Scalar(255, 255, 255), 1);
+  for (int hour = 3; hour < 24; hour += 3) {
+    cv::line(*bgr, {bar.X(hour / 24.0), bar.y + bar.height}, {bar.X(hour / 24.0), bar.y + bar.height + 4},
+             cv::Scalar(255, 255, 255), 1);
+  }
+  const int now = bar.X(slider.Fraction(frame_utc));
+  cv::line(*bgr, {now, bar.y - 4}, {now, bar.y + bar.height + 4}, cv::Scalar(255, 255, 255), 2);
+  const auto text = [&](const std::string& line) {
+    cv::putText(*bgr, line, {bar.x0, bar.y - 8}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
+    cv::putText(*bgr, line, {bar.x0, bar.y - 8}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
+  };
+  const std::optional<UtcTime> target = slider.Target(frame_utc);
+  if (!target || !relit_sun) {
+    text(target ? "no estimate yet: shown as it is" : "time of day: <- -> 15 min, up/down 1 h, or click the bar");
+    return;
+  }
+  const int x = bar.X(*slider.solar_minutes() / relight::TimeSlider::kDayMinutes);
+  cv::circle(*bgr, {x, bar.y + bar.height / 2}, 7, cv::Scalar(0, 200, 255), cv::FILLED, cv::LINE_AA);
+  cv::circle(*bgr, {x, bar.y + bar.height / 2}, 7, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  const int solar = static_cast<int>(std::lround(*slider.solar_minutes()));
+  const UtcTime utc = UtcFromUnixSeconds(60.0 * std::round(UnixSeconds(*target) / 60.0));
+  const double elevation = relit_sun->position.ApparentElevationDeg();
+  text(fmt::format("relit to {:02d}:{:02d} UTC (solar {:02d}:{:02d}), sun {}  [Backspace: the frame's own time]",
+                   utc.hour, utc.minute, solar / 60 % 24, solar % 60,
+                   relit_sun->dir.z > 0.0 ? fmt::format("{:.1f} deg up, {:.1f} deg az", elevation, relit_sun->position.azimuth_deg)
+                                          : fmt::format("{:.1f} deg below the horizon: sky only", -elevation)));
 }
 
 struct FrameFidelity {
@@ -115,6 +194,11 @@ void RunReplay(const ReplayOptions& o) {
   }
   if (!o.screenshot.empty() && !o.window) ThrowInputError("--screenshot: needs --window");
   if (!o.screenshot.empty() && fs::path(o.screenshot).extension() != ".png") ThrowInputError("--screenshot: {} must end in .png", o.screenshot);
+  if (!o.relight_at.empty() && !o.window) ThrowInputError("--relight-at: needs --window (daylit relight writes a relit video)");
+  render::FrameRendererOptions render_options;
+  render_options.lights = render::ParseLighting(o.lighting, "--lighting");
+  relight::TimeSlider slider(scene.location.longitude_deg);
+  if (!o.relight_at.empty()) slider.SetUtcMinutes(relight::ParseUtcTimeOfDay(o.relight_at, "--relight-at"));
   // Everything that can fail without the bake fails before it: the frames, GL, the output.
   std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
   // In a window, a recording plays at its own pace; a camera paces itself.
@@ -140,7 +224,7 @@ void RunReplay(const ReplayOptions& o) {
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, cache, &loaded);
   Log().info("{} the bake: {}", loaded ? "loaded" : "made", cache.string());
   const scene::RayCaster caster(scene.model);
-  render::FrameRenderer renderer(scene, baked, caster);
+  render::FrameRenderer renderer(scene, baked, caster, render_options);
   if (gl) Log().info("rendering with {} ({})", gl->renderer(), gl->platform());
   const int w = renderer.width(), h = renderer.height();
 
@@ -152,6 +236,9 @@ void RunReplay(const ReplayOptions& o) {
   cv::Mat shown_rgb(h, w, CV_32FC3), shown;
   Clock::time_point last_shown = Clock::now();
   double shown_fps = 0.0;
+  // The window's time slider relights the frames (relight::ImageRelighter, made when first used).
+  std::unique_ptr<relight::ImageRelighter> relighter;
+  SunlitDay sunlit_day;
   estimation::EstimateOptions options;
   options.max_frames = o.frames;
   options.progress_label = "replay";
@@ -166,9 +253,27 @@ void RunReplay(const ReplayOptions& o) {
     }
     const Clock::time_point t0 = Clock::now();
     if (video) composite = video->TakeBuffer();
-    renderer.Render(frame, row.light, overcast_share, sun_dir, &composite);
+    if (window) ApplyInput(window->TakeInput(), row.time_utc, SliderBar::Of(w, h), &slider);
+    // Relit to the slider's time: the frame times E_new / E_now, the objects under the new sun.
+    std::optional<scene::SceneSun> relit_sun;
+    const std::optional<UtcTime> relit_to = slider.Target(row.time_utc);
+    if (relit_to && row.light.sky_rgb.x + row.light.sky_rgb.y + row.light.sky_rgb.z > 0.0) {
+      relit_sun = scene::SunAt(scene, *relit_to);
+      const glm::vec3 next_sun(relit_sun->dir);
+      if (relighter == nullptr) relighter = std::make_unique<relight::ImageRelighter>(scene, baked, caster);
+      relighter->SetSuns(sun_dir, next_sun);
+      estimation::SunSky next = row.light;
+      if (next_sun.z <= 0.0f) next.sun_rgb = glm::dvec3(0.0);
+      renderer.Linearize(frame, &composite);
+      relighter->Apply(relight::SplitLight(row.light, overcast_share), relight::SplitLight(next, overcast_share),
+                       composite.data());
+      renderer.RenderLinear(next, overcast_share, next_sun, composite.data());
+    } else {
+      renderer.Render(frame, row.light, overcast_share, sun_dir, &composite);
+    }
     render_ms.push_back(1e3 * std::chrono::duration<double>(Clock::now() - t0).count());
-    if (const std::optional<render::TruthFrame> truth = render::ReadTruthFrame(scene, frame.index)) {
+    const std::optional<render::TruthFrame> truth = relit_to ? std::nullopt : render::ReadTruthFrame(scene, frame.index);
+    if (truth) {
       renderer.Linearize(frame, &linear);
       const render::CompositeFidelity f = render::CompareComposite(composite, linear, truth->with, truth->without, truth->mask);
       fidelity.push_back({frame.index, f});
@@ -187,6 +292,7 @@ void RunReplay(const ReplayOptions& o) {
       shown_fps = shown_fps == 0.0 ? 1.0 / std::max(dt, 1e-3) : 0.9 * shown_fps + 0.1 / std::max(dt, 1e-3);
       last_shown = now;
       DrawOverlay(&shown, shown_fps, row, to_screen);
+      DrawTimeSlider(&shown, slider, scene, row.time_utc, relit_sun, &sunlit_day);
       if (!window->Show(shown)) g_stop_replay = true;  // closed: end as Ctrl-C does
     }
     if (video) video->Write(std::move(composite), frame.exposure);
@@ -257,7 +363,11 @@ void AddPipelineOptions(CLI::App* cmd, const std::shared_ptr<ReplayOptions>& opt
   cmd->add_flag("--window", options->window,
                 "Show it in a window instead of writing the video (with fps, the sun and E_sun/E_sky swatches); "
                 "--out as well writes both; Esc, Q or closing the window ends it");
+  AddLightingOption(cmd, &options->lighting);
   cmd->add_option("--screenshot", options->screenshot, "With --window: the window's last frame as a PNG");
+  cmd->add_option("--relight-at", options->relight_at,
+                  "With --window: start the time slider at this UTC time of day (HH:MM); the frames are shown "
+                  "relit to the sun of that time on their own day (daylit relight's ratio), objects included");
   cmd->callback([options, out] {
     options->out_given = out->count() > 0;
     RunReplay(*options);
