@@ -476,7 +476,7 @@ TEST(CliTest, TheWindowsTimeSliderRelightsTheFrames) {
   fs::create_directories(dir);
   const std::string cache = " --cache " + std::string(DAYLIT_BINARY_DIR) + "/test-cache/courtyard-a";
   const CliRun shown = Daylit("replay " + kRecording + " --window --frames 1 --relight-at 16:30 --screenshot " +
-                                  (dir / "shot.png").string() + cache,
+                                  (dir / "shot.png").string() + " --out " + (dir / "w.mp4").string() + cache,
                               kGlEnvironment + "xvfb-run -a -s '-screen 0 1280x1024x24' ");
   ASSERT_EQ(shown.exit_code, 0) << shown.err;
   const CliRun relit = Daylit("relight " + kRecording + " --frame 0 --at 2026-06-21T16:30:00Z --objects --out " +
