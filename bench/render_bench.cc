@@ -14,7 +14,9 @@
 #include "render/frame_renderer.h"
 #include "render/gl_context.h"
 #include "render/image_relight_gl.h"
+#include "relight/env_lights.h"
 #include "relight/image_relight.h"
+#include "scene/object_mesh.h"
 #include "capture/frame_source.h"
 #include "scene/scene.h"
 
@@ -64,9 +66,12 @@ void BM_CompositeFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_CompositeFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// Arg: 0 the irradiance volume, N the sun plus N lights fitted to the relit map (--lighting lights:N).
 void BM_RenderFrame(benchmark::State& state) {
   Courtyard& c = Courtyard::Get();
-  FrameRenderer renderer(c.scene, c.bake, *c.caster);
+  FrameRendererOptions options;
+  options.lights = static_cast<int>(state.range(0));
+  FrameRenderer renderer(c.scene, c.bake, *c.caster, options);
   std::vector<float> out;
   renderer.Render(c.fit.frame, c.fit.fit.light, c.fit.fit.overcast_share, c.fit.sun_dir, &out);  // the sun's one-off work
   for (auto _ : state) {
@@ -75,7 +80,28 @@ void BM_RenderFrame(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_RenderFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RenderFrame)->Arg(0)->Arg(2)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// --lighting lights:N when the sun moves or the light changes much: the relit map's three parts
+// reprojected to the objects, their exact irradiance at the fit's normals, Irradiance
+// Optimization of the N directions and the per-part linear fit.
+void BM_FitEnvLights(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  relight::EnvRelighter relighter(c.bake, glm::vec3(c.scene.envmap->position), *c.caster);
+  relighter.SetSun(c.fit.sun_dir);
+  relight::EnvBasis basis;
+  relighter.Basis(&basis);
+  glm::vec3 lo, hi;
+  scene::ObjectsModel(c.scene.objects).Bounds(&lo, &hi);
+  relight::EnvLights lights(static_cast<int>(state.range(0)), *c.caster, 0.5f * (lo + hi), glm::vec3(c.scene.envmap->position),
+                            c.bake.env.width, c.bake.env.height);
+  const relight::LightParts parts = relight::SplitLight(c.fit.fit.light, c.fit.fit.overcast_share);
+  for (auto _ : state) {
+    lights.SetBasis(basis);
+    benchmark::DoNotOptimize(lights.Update(parts));
+  }
+}
+BENCHMARK(BM_FitEnvLights)->Arg(2)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_RendererSetUp(benchmark::State& state) {
   Courtyard& c = Courtyard::Get();

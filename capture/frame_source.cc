@@ -202,7 +202,11 @@ class PacedSource final : public FrameSource {
     stats_ = source_->stats();
     if (status != FrameStatus::kFrame && status != FrameStatus::kUndecodable) return status;
     const auto now = std::chrono::steady_clock::now();
-    if (!first_) {
+    // A gap of more than kMaxGap between two frames (a time-lapse's bursts hours apart) is not
+    // waited for: pacing starts again from the frame after it.
+    const bool gap = previous_ && frame->utc.SecondsSince(*previous_) / speed_ > kMaxGapSeconds;
+    previous_ = frame->utc;
+    if (!first_ || gap) {
       first_ = frame->utc, start_ = now;
       return status;
     }
@@ -213,15 +217,16 @@ class PacedSource final : public FrameSource {
   }
   void Seek(int index) override {
     source_->Seek(index);
-    first_.reset();  // pacing restarts at the new position
+    first_.reset(), previous_.reset();  // pacing restarts at the new position
   }
   std::string Describe() const override { return fmt::format("{}, paced ×{:g}", source_->Describe(), speed_); }
   bool live() const override { return source_->live(); }
 
  private:
+  static constexpr double kMaxGapSeconds = 2.0;
   std::unique_ptr<FrameSource> source_;
   double speed_;
-  std::optional<UtcTime> first_;
+  std::optional<UtcTime> first_, previous_;
   std::chrono::steady_clock::time_point start_;
 };
 

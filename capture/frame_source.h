@@ -68,7 +68,9 @@ std::unique_ptr<FrameSource> OpenImageSequence(std::string pattern, FrameTimes t
 std::filesystem::path FramePath(const std::string& pattern, int index);
 
 // `source` paced to its timestamps: each frame is returned no earlier than its time after the
-// first frame's, divided by `speed`, on the steady clock (for replay in a window).
+// first frame's, divided by `speed`, on the steady clock (for replay in a window). A gap of more
+// than 2 s (after dividing by `speed`) between two frames, such as a time-lapse's bursts hours
+// apart, is skipped: pacing starts again from the frame after it.
 std::unique_ptr<FrameSource> Paced(std::unique_ptr<FrameSource> source, double speed);
 
 }  // namespace daylit::capture

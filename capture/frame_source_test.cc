@@ -182,6 +182,24 @@ TEST(FrameSourceTest, PacedReplayKeepsToTheTimestamps) {
   EXPECT_EQ(source->stats().delivered, 5);
 }
 
+TEST(FrameSourceTest, PacedReplaySkipsTheGapsOfATimeLapse) {
+  // Frames 98, 99 (the end of the first burst) and 100, 101 (the next, 2 h 12 min later): paced
+  // at 1×, two frame intervals, not hours.
+  FrameTimes times = Times();
+  times.frames.resize(102);
+  ASSERT_GT(times.frames[100].utc.SecondsSince(times.frames[99].utc), 3600.0);
+  auto source = Paced(OpenVideoSource(kRecording / "video.mp4", times, 1.0), 1.0);
+  source->Seek(98);
+  Frame frame;
+  const auto start = std::chrono::steady_clock::now();
+  int n = 0;
+  while (source->Next(&frame) == FrameStatus::kFrame) ++n;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(n, 4);
+  EXPECT_GE(seconds, 0.2);  // within each burst, still paced
+  EXPECT_LT(seconds, 5.0);
+}
+
 TEST(FrameSourceTest, FramePathFormatsThePattern) {
   EXPECT_EQ(FramePath("/a/%06d.png", 42), fs::path("/a/000042.png"));
   EXPECT_EQ(FramePath("/a/f%d.exr", 7), fs::path("/a/f7.exr"));

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <string>
 
+#include <fmt/format.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
@@ -62,7 +64,9 @@ void main() {
 // the coefficients already). SH_c(p): the volume's trilinear coefficients at the vertices,
 // interpolated across the triangle (meshes are finer than the probe grid; the builtin ones are),
 // evaluated with the fragment's own normal.
-const char* kObjectFragment = R"(#version 330 core
+// Compiled with LIGHTS defined as CompositorOptions::lights (ObjectFragment): with none, nothing
+// of the lights is in the shader, which llvmpipe would otherwise pay for.
+const char* kObjectFragment = R"(
 in vec3 world_position;
 in vec3 world_normal;
 in vec3 vertex_sun_loss;
@@ -76,16 +80,16 @@ uniform mat4 shadow_from_world;
 uniform sampler2DShadow shadow_map;
 uniform float shadow_texel;
 uniform bool has_volume;
+#if LIGHTS > 0
 // Instead of the volume: directional lights and an ambient term (relight::EnvLights), each light
 // with its own shadow map, a layer of light_maps.
-const int kMaxLights = 16;
-uniform int light_count;
 uniform vec3 ambient;
-uniform vec3 light_dir[kMaxLights];
-uniform vec3 light_rgb[kMaxLights];
-uniform mat4 light_shadow_from_world[kMaxLights];
-uniform float light_texel[kMaxLights];
+uniform vec3 light_dir[LIGHTS];
+uniform vec3 light_rgb[LIGHTS];
+uniform mat4 light_shadow_from_world[LIGHTS];
+uniform float light_texel[LIGHTS];
 uniform sampler2DArrayShadow light_maps;
+#endif
 out vec4 color;
 const float kPi = 3.14159265358979;
 
@@ -99,16 +103,15 @@ float SunVisibility(vec3 p, vec3 n) {
                  texture(shadow_map, vec3(q.xy + vec2(-d.x, d.y), q.z)) + texture(shadow_map, vec3(q.xy + vec2(d.x, d.y), q.z)));
 }
 
+#if LIGHTS > 0
+// One fetch, the hardware's 2×2 PCF: these lights stand for broad regions of sky, whose
+// shadows are soft anyway.
 float LightVisibility(int i, vec3 p, vec3 n) {
   vec4 s = light_shadow_from_world[i] * vec4(p + n * 4.0 * light_texel[i], 1.0);
   vec3 q = s.xyz / s.w * 0.5 + 0.5;
-  vec2 d = vec2(0.5) / vec2(textureSize(light_maps, 0).xy);
-  float layer = float(i);
-  return 0.25 * (texture(light_maps, vec4(q.xy + vec2(-d.x, -d.y), layer, q.z)) +
-                 texture(light_maps, vec4(q.xy + vec2(d.x, -d.y), layer, q.z)) +
-                 texture(light_maps, vec4(q.xy + vec2(-d.x, d.y), layer, q.z)) +
-                 texture(light_maps, vec4(q.xy + vec2(d.x, d.y), layer, q.z)));
+  return texture(light_maps, vec4(q.xy, float(i), q.z));
 }
+#endif
 
 void main() {
   vec3 n = normalize(world_normal);
@@ -126,13 +129,16 @@ void main() {
     e += vertex_sh[6] * 0.315392 * (3.0 * z * z - 1.0);
     e += vertex_sh[7] * 1.092548 * x * z;
     e += vertex_sh[8] * 0.546274 * (x * x - y * y);
-  } else if (light_count > 0) {
+  }
+#if LIGHTS > 0
+  else {
     e += ambient;
-    for (int i = 0; i < light_count; ++i) {
+    for (int i = 0; i < LIGHTS; ++i) {
       float c = max(dot(n, light_dir[i]), 0.0);
       if (c > 0.0) e += light_rgb[i] * c * LightVisibility(i, world_position, n);
     }
   }
+#endif
   // The bounce from real ground the objects themselves shade (relight::ObjectBounce; zero
   // unless set).
   e -= sun_rgb * vertex_sun_loss + sky_rgb * vertex_sky_loss;
@@ -268,7 +274,7 @@ struct Compositor::Gl {
   float shadow_texel = 0.0f;
   GlProgram background{kFullScreenTriangle, kBackgroundFragment};
   GlProgram depth{kDepthVertex, kDepthFragment};
-  GlProgram object{kObjectVertex, kObjectFragment};
+  std::unique_ptr<GlProgram> object_program;  // ObjectFragment(options.lights)
   GlVertexArray empty_vao = NewVertexArray();
   DrawMesh model;
   std::vector<DrawMesh> objects;
@@ -317,6 +323,9 @@ Compositor::Rect ProjectedRect(const std::vector<glm::vec3>& vertices, const glm
 Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& options) : gl_(std::make_unique<Gl>()) {
   Gl& g = *gl_;
   g.options = options;
+  if (options.lights < 0 || options.lights > kMaxLights) ThrowInputError("Compositor: {} lights; 0 to {}", options.lights, kMaxLights);
+  const std::string fragment = fmt::format("#version 330 core\n#define LIGHTS {}\n", options.lights) + kObjectFragment;
+  g.object_program = std::make_unique<GlProgram>(kObjectVertex, fragment.c_str());
   g.width = scene.intrinsics.width, g.height = scene.intrinsics.height;
   const glm::mat4 camera_from_world = CameraFromWorld(scene.cam_from_world);
   // The real model, for depth only.
@@ -410,8 +419,10 @@ void Compositor::Render(const CompositeInput& input, float* image) {
   // The lights' shadow maps, redrawn when their directions change. A light that stands for the
   // real model's reflected light is shadowed by the objects only.
   const int light_count = input.lights != nullptr ? static_cast<int>(input.lights->lights.size()) : 0;
+  if (light_count != 0 && light_count != g.options.lights) {
+    ThrowInputError("Compositor: {} lights given, made for {}", light_count, g.options.lights);
+  }
   if (light_count > 0 && input.lights_generation != g.light_generation) {
-    if (light_count > kMaxLights) ThrowInputError("Compositor: {} lights; at most {}", light_count, kMaxLights);
     const int size = g.options.light_shadow_map_size;
     if (g.light_layers < light_count) {
       glBindTexture(GL_TEXTURE_2D_ARRAY, g.light_maps.get());
@@ -483,37 +494,36 @@ void Compositor::Render(const CompositeInput& input, float* image) {
   glUniformMatrix4fv(g.depth.Uniform("clip_from_world"), 1, GL_FALSE, glm::value_ptr(g.clip_from_world));
   Draw(g.model);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glUseProgram(g.object.id());
-  glUniformMatrix4fv(g.object.Uniform("clip_from_world"), 1, GL_FALSE, glm::value_ptr(g.clip_from_world));
-  glUniformMatrix4fv(g.object.Uniform("shadow_from_world"), 1, GL_FALSE, glm::value_ptr(g.shadow_from_world));
-  glUniform3fv(g.object.Uniform("sun_dir"), 1, glm::value_ptr(sun));
+  glUseProgram(g.object_program->id());
+  glUniformMatrix4fv(g.object_program->Uniform("clip_from_world"), 1, GL_FALSE, glm::value_ptr(g.clip_from_world));
+  glUniformMatrix4fv(g.object_program->Uniform("shadow_from_world"), 1, GL_FALSE, glm::value_ptr(g.shadow_from_world));
+  glUniform3fv(g.object_program->Uniform("sun_dir"), 1, glm::value_ptr(sun));
   const glm::vec3 sun_rgb = sun_up ? glm::vec3(input.light.sun_rgb) : glm::vec3(0.0f);
-  glUniform3fv(g.object.Uniform("sun_rgb"), 1, glm::value_ptr(sun_rgb));
+  glUniform3fv(g.object_program->Uniform("sun_rgb"), 1, glm::value_ptr(sun_rgb));
   const glm::vec3 sky_rgb(input.light.sky_rgb);
-  glUniform3fv(g.object.Uniform("sky_rgb"), 1, glm::value_ptr(sky_rgb));
-  glUniform1f(g.object.Uniform("shadow_texel"), g.shadow_texel);
+  glUniform3fv(g.object_program->Uniform("sky_rgb"), 1, glm::value_ptr(sky_rgb));
+  glUniform1f(g.object_program->Uniform("shadow_texel"), g.shadow_texel);
   glActiveTexture(GL_TEXTURE1);
   glBindTexture(GL_TEXTURE_2D, g.shadow_map.get());
-  glUniform1i(g.object.Uniform("shadow_map"), 1);
-  glUniform1i(g.object.Uniform("has_volume"), has_volume ? 1 : 0);
-  glUniform1i(g.object.Uniform("light_count"), has_volume ? 0 : light_count);
+  glUniform1i(g.object_program->Uniform("shadow_map"), 1);
+  glUniform1i(g.object_program->Uniform("has_volume"), has_volume ? 1 : 0);
   if (light_count > 0) {
     std::vector<glm::vec3> dirs, rgbs;
     for (const relight::DirectionalLight& l : input.lights->lights) dirs.push_back(glm::normalize(l.direction)), rgbs.push_back(l.irradiance);
-    glUniform3fv(g.object.Uniform("ambient"), 1, glm::value_ptr(input.lights->ambient));
-    glUniform3fv(g.object.Uniform("light_dir"), light_count, glm::value_ptr(dirs[0]));
-    glUniform3fv(g.object.Uniform("light_rgb"), light_count, glm::value_ptr(rgbs[0]));
-    glUniformMatrix4fv(g.object.Uniform("light_shadow_from_world"), light_count, GL_FALSE,
+    glUniform3fv(g.object_program->Uniform("ambient"), 1, glm::value_ptr(input.lights->ambient));
+    glUniform3fv(g.object_program->Uniform("light_dir"), light_count, glm::value_ptr(dirs[0]));
+    glUniform3fv(g.object_program->Uniform("light_rgb"), light_count, glm::value_ptr(rgbs[0]));
+    glUniformMatrix4fv(g.object_program->Uniform("light_shadow_from_world"), light_count, GL_FALSE,
                        glm::value_ptr(g.light_shadow_from_world[0]));
-    glUniform1fv(g.object.Uniform("light_texel"), light_count, g.light_texel.data());
+    glUniform1fv(g.object_program->Uniform("light_texel"), light_count, g.light_texel.data());
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, g.light_maps.get());
+    glUniform1i(g.object_program->Uniform("light_maps"), 2);
   }
-  glActiveTexture(GL_TEXTURE2);
-  glBindTexture(GL_TEXTURE_2D_ARRAY, g.light_maps.get());
-  glUniform1i(g.object.Uniform("light_maps"), 2);
   for (const DrawMesh& m : g.objects) {
     // A closed mesh's back faces are hidden by its front ones: not drawing them halves the work.
     if (m.closed) glEnable(GL_CULL_FACE);
-    glUniform3fv(g.object.Uniform("albedo"), 1, glm::value_ptr(m.albedo));
+    glUniform3fv(g.object_program->Uniform("albedo"), 1, glm::value_ptr(m.albedo));
     Draw(m);
     glDisable(GL_CULL_FACE);
   }

@@ -31,8 +31,8 @@ struct CompositeInput {
   estimation::SunSky light;           // E_sun (DNI) and E_sky, radiance units
   glm::vec3 sun_dir{0.0f, 0.0f, 1.0f};  // unit, toward the sun, scene coordinates
   const relight::IrradianceVolume* volume = nullptr;  // updated for this frame; always the same one; null: no indirect light
-  // Instead of the volume (null), directional lights and an ambient term (relight::EnvLights, at
-  // most 16), each with a shadow map; `lights_reflected` per light: 1 when only the objects shadow
+  // Instead of the volume (null), directional lights and an ambient term (relight::EnvLights;
+  // as many as CompositorOptions::lights), each with a shadow map; `lights_reflected` per light: 1 when only the objects shadow
   // it. Their shadow maps are redrawn when `lights_generation` changes.
   const relight::LightSet* lights = nullptr;
   const std::vector<uint8_t>* lights_reflected = nullptr;
@@ -42,7 +42,8 @@ struct CompositeInput {
 struct CompositorOptions {
   int samples = 4;             // MSAA
   int shadow_map_size = 2048;  // texels over the objects' bounds, seen from the sun
-  int light_shadow_map_size = 1024;  // the same for each of CompositeInput::lights
+  int lights = 0;                    // the number of CompositeInput::lights it is made for (0 to 16)
+  int light_shadow_map_size = 1024;  // the shadow map's size for each of them
 };
 
 class Compositor {

@@ -187,7 +187,9 @@ TEST(CompositorTest, LightsCastShadowsUnlessTheModelReflectsThem) {
   ASSERT_TRUE(shadowed && sunlit);
   scene::Scene s = f.scene;
   s.objects = {Sphere(*shadowed, 0.15), Sphere(*sunlit, 0.15)};
-  Compositor compositor(s);
+  CompositorOptions one_light;
+  one_light.lights = 1;
+  Compositor compositor(s, one_light);
   relight::LightSet lights;
   lights.ambient = glm::vec3(0.1f, 0.2f, 0.3f);
   lights.lights = {{f.sun, glm::vec3(10.0f, 20.0f, 30.0f)}};

@@ -4,6 +4,15 @@
 #include "scene/object_mesh.h"
 
 namespace daylit::render {
+namespace {
+
+CompositorOptions CompositorFor(const FrameRendererOptions& options, const scene::Scene& scene) {
+  CompositorOptions compositor = options.compositor;
+  compositor.lights = scene.objects.empty() ? 0 : options.lights;
+  return compositor;
+}
+
+}  // namespace
 
 FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
                              const FrameRendererOptions& options)
@@ -14,7 +23,7 @@ FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& b
       shadows_(scene, bake, caster, objects_),
       bounce_(scene, bake, caster, objects_),
       relighter_(bake, scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f), caster),
-      compositor_(scene, options.compositor),
+      compositor_(scene, CompositorFor(options, scene)),
       linearizer_(scene.response) {
   scene::CheckObjectsOutsideModel(objects_model_, caster, scene.file.string());
   if (!bake.gather.directions.empty()) {

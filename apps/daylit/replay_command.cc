@@ -315,6 +315,10 @@ void RunReplay(const ReplayOptions& o) {
   say(fmt::format("  per frame (median): estimate {:.1f} ms, relight + render {:.1f} ms (encoding on its own thread)",
                   run.median_frame_ms, MedianInPlace(render_ms, 0.0)));
   if (run.undecodable > 0) say(fmt::format("  {} frames could not be decoded (shown as the frame before)", run.undecodable));
+  if (const relight::EnvLights* lights = renderer.env_lights()) {
+    say(fmt::format("  the objects lit by the sun and {} lights, their directions fitted {} times (sun moves and large "
+                    "changes of the light)", lights->count(), lights->generation()));
+  }
   WriteFileAtomically(dir / "estimates.csv", estimation::EstimatesCsv(run.frames));
   std::optional<estimation::TruthComparison> lighting;
   if (scene.groundtruth.lighting) {
