@@ -65,6 +65,39 @@ scene::VirtualObject Sphere(const glm::dvec3& centre, double radius) {
   return o;
 }
 
+// Two spots for a 0.15 m sphere on the ground the camera sees, under fixture `f`'s sun: one wholly
+// in a wall's shadow and one wholly in the sun (Embree decides: all or none of 27 points of the
+// sphere's bounding cube see the sun), apart across the sun's direction so neither shadows the
+// other.
+struct ShadowAndSun {
+  std::optional<glm::dvec3> shadowed, sunlit;
+};
+
+ShadowAndSun FindShadowAndSun(const Fixture& f) {
+  const scene::CameraModel camera = f.scene.Camera();
+  const scene::RayCaster real(f.scene.model);
+  ShadowAndSun found;
+  for (int y = f.scene.intrinsics.height / 2; y < f.scene.intrinsics.height && !(found.shadowed && found.sunlit); y += 9) {
+    for (int x = 20; x < f.scene.intrinsics.width - 20 && !(found.shadowed && found.sunlit); x += 23) {
+      const glm::dvec3 dir = camera.UnprojectToWorldRay(glm::dvec2(x, y));
+      const scene::RayHit hit = real.Intersect(glm::vec3(camera.CenterInWorld()), glm::vec3(dir));
+      if (!hit.IsHit() || hit.normal.z < 0.9f || hit.t > 20.0f) continue;  // ground only
+      const glm::dvec3 centre = camera.CenterInWorld() + static_cast<double>(hit.t) * dir + glm::dvec3(0, 0, 0.16);
+      int blocked = 0;
+      for (int k = 0; k < 27; ++k) {  // the sphere's bounding cube, corners and centres
+        const glm::dvec3 q = centre + 0.15 * glm::dvec3(k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1);
+        blocked += real.Occluded(glm::vec3(q), f.sun) ? 1 : 0;
+      }
+      const auto apart = [&](const std::optional<glm::dvec3>& other) {
+        return !other || glm::length(glm::cross(*other - centre, glm::dvec3(f.sun))) > 1.0;
+      };
+      if (blocked == 27 && !found.shadowed && apart(found.sunlit)) found.shadowed = centre;
+      if (blocked == 0 && !found.sunlit && apart(found.shadowed)) found.sunlit = centre;
+    }
+  }
+  return found;
+}
+
 TEST(CompositorTest, ObjectsAppearWhereTheCameraProjectsThemLitByTheSunAndNothingElseChanges) {
   Fixture f;
   const std::vector<float> image = f.Render(f.scene.objects);
@@ -127,25 +160,8 @@ TEST(CompositorTest, ARealWallHidesAnObjectBehindIt) {
 TEST(CompositorTest, AnObjectInARealShadowGetsNoSun) {
   Fixture f(0);  // 05:00, the sun 17° high: long wall shadows on the ground
   const scene::CameraModel camera = f.scene.Camera();
-  const scene::RayCaster real(f.scene.model);
-  // Two small spheres on the ground the camera sees: one wholly in a wall's shadow, one wholly in
-  // the sun (Embree decides which), rendered together.
-  std::optional<glm::dvec3> shadowed, sunlit;
-  for (int y = f.scene.intrinsics.height / 2; y < f.scene.intrinsics.height && !(shadowed && sunlit); y += 9) {
-    for (int x = 20; x < f.scene.intrinsics.width - 20 && !(shadowed && sunlit); x += 23) {
-      const glm::dvec3 dir = camera.UnprojectToWorldRay(glm::dvec2(x, y));
-      const scene::RayHit hit = real.Intersect(glm::vec3(camera.CenterInWorld()), glm::vec3(dir));
-      if (!hit.IsHit() || hit.normal.z < 0.9f || hit.t > 20.0f) continue;  // ground only
-      const glm::dvec3 centre = camera.CenterInWorld() + static_cast<double>(hit.t) * dir + glm::dvec3(0, 0, 0.16);
-      int blocked = 0;
-      for (int k = 0; k < 27; ++k) {  // the sphere's bounding cube, corners and centres
-        const glm::dvec3 q = centre + 0.15 * glm::dvec3(k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1);
-        blocked += real.Occluded(glm::vec3(q), f.sun) ? 1 : 0;
-      }
-      if (blocked == 27 && !shadowed && (!sunlit || glm::distance(*sunlit, centre) > 1.0)) shadowed = centre;
-      if (blocked == 0 && !sunlit && (!shadowed || glm::distance(*shadowed, centre) > 1.0)) sunlit = centre;
-    }
-  }
+  // Two small spheres on the ground, one in a wall's shadow and one in the sun, rendered together.
+  const auto [shadowed, sunlit] = FindShadowAndSun(f);
   ASSERT_TRUE(shadowed.has_value()) << "no ground in a wall's shadow";
   ASSERT_TRUE(sunlit.has_value()) << "no ground in the sun";
   const std::vector<float> image = f.Render({Sphere(*shadowed, 0.15), Sphere(*sunlit, 0.15)});
@@ -163,27 +179,7 @@ TEST(CompositorTest, AnObjectInARealShadowGetsNoSun) {
 TEST(CompositorTest, LightsCastShadowsUnlessTheModelReflectsThem) {
   Fixture f(0);
   const scene::CameraModel camera = f.scene.Camera();
-  const scene::RayCaster real(f.scene.model);
-  std::optional<glm::dvec3> shadowed, sunlit;
-  for (int y = f.scene.intrinsics.height / 2; y < f.scene.intrinsics.height && !(shadowed && sunlit); y += 9) {
-    for (int x = 20; x < f.scene.intrinsics.width - 20 && !(shadowed && sunlit); x += 23) {
-      const glm::dvec3 dir = camera.UnprojectToWorldRay(glm::dvec2(x, y));
-      const scene::RayHit hit = real.Intersect(glm::vec3(camera.CenterInWorld()), glm::vec3(dir));
-      if (!hit.IsHit() || hit.normal.z < 0.9f || hit.t > 20.0f) continue;
-      const glm::dvec3 centre = camera.CenterInWorld() + static_cast<double>(hit.t) * dir + glm::dvec3(0, 0, 0.16);
-      int blocked = 0;
-      for (int k = 0; k < 27; ++k) {
-        const glm::dvec3 q = centre + 0.15 * glm::dvec3(k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1);
-        blocked += real.Occluded(glm::vec3(q), f.sun) ? 1 : 0;
-      }
-      // Apart across the sun's direction, so neither shadows the other.
-      const auto apart = [&](const std::optional<glm::dvec3>& other) {
-        return !other || glm::length(glm::cross(*other - centre, glm::dvec3(f.sun))) > 1.0;
-      };
-      if (blocked == 27 && !shadowed && apart(sunlit)) shadowed = centre;
-      if (blocked == 0 && !sunlit && apart(shadowed)) sunlit = centre;
-    }
-  }
+  const auto [shadowed, sunlit] = FindShadowAndSun(f);
   ASSERT_TRUE(shadowed && sunlit);
   scene::Scene s = f.scene;
   s.objects = {Sphere(*shadowed, 0.15), Sphere(*sunlit, 0.15)};
