@@ -126,11 +126,15 @@ void VideoEncoder::Finish() {
 void RgbToYuv420(const cv::Mat& rgb, uint8_t* y, int y_stride, uint8_t* u, int u_stride, uint8_t* v, int v_stride) {
   constexpr float kr = 0.299f, kb = 0.114f, kg = 1.0f - kr - kb;
   const int w = rgb.cols, h = rgb.rows;
-  const auto code = [](float x) { return static_cast<uint8_t>(std::clamp(std::lround(x), 0L, 255L)); };
+  // Rounded half away from zero, as std::lround, without its libm call: x is clamped to [0, 255]
+  // first, so truncating x + 0.5 is the same.
+  const auto code = [](float x) { return static_cast<uint8_t>(std::clamp(x, 0.0f, 255.0f) + 0.5f); };
   // Luma per pixel; Cb, Cr per pixel as floats, then sited: a chroma sample (i, j) sits at luma
   // column 2i (a [1 2 1]/4 filter across it) between rows 2j and 2j + 1 (their mean), as the
-  // decoder's bilinear upsampling assumes.
-  cv::Mat cb(h, w, CV_32F), cr(h, w, CV_32F);
+  // decoder's bilinear upsampling assumes. The planes are kept per thread: no 4 MB of fresh
+  // pages every frame.
+  thread_local cv::Mat cb, cr;
+  cb.create(h, w, CV_32F), cr.create(h, w, CV_32F);
   for (int row = 0; row < h; ++row) {
     const auto* p = rgb.ptr<cv::Vec3f>(row);
     uint8_t* luma = y + static_cast<ptrdiff_t>(row) * y_stride;
