@@ -46,6 +46,9 @@ struct FrameEstimate {
   double confidence = 0.0;
   int samples = 0;
   bool decoded = true;             // false: the frame could not be decoded (the estimate holds)
+
+  // False until the first usable fit: the light is all zero before it.
+  bool HasEstimate() const { return light.sky_rgb.x + light.sky_rgb.y + light.sky_rgb.z > 0.0; }
 };
 
 struct EstimateRun {

@@ -106,7 +106,8 @@ void EnvLights::FitDirections(const LightParts& parts) {
   }
   reflected_.assign(directions_.size(), 0);
   for (size_t i = 0; i < directions_.size(); ++i) reflected_[i] = model_.Occluded(objects_centre_, directions_[i], 1e-3f) ? 1 : 0;
-  fit_error_ = ErrorOf(Combine(parts), parts);
+  current_ = Combine(parts);
+  error_ = fit_error_ = ErrorOf(current_, parts);
   stale_ = false;
   ++generation_;
 }
@@ -135,14 +136,12 @@ double EnvLights::ErrorOf(const LightSet& lights, const LightParts& parts) const
 }
 
 const LightSet& EnvLights::Update(const LightParts& parts) {
-  if (stale_) FitDirections(parts);
-  current_ = Combine(parts);
-  error_ = ErrorOf(current_, parts);
-  if (error_ > fit_error_ + kRefitWorsening) {
-    FitDirections(parts);
+  if (!stale_) {
     current_ = Combine(parts);
-    error_ = fit_error_;
+    error_ = ErrorOf(current_, parts);
+    if (error_ <= fit_error_ + kRefitWorsening) return current_;
   }
+  FitDirections(parts);  // a new basis, or drifted too far: current_ and error_ from a new fit
   return current_;
 }
 

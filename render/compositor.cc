@@ -12,6 +12,7 @@
 #include "base/error.h"
 #include "render/gl_program.h"
 #include "render/projection.h"
+#include "relight/env_lights.h"
 #include "relight/irradiance_volume.h"
 #include "scene/object_mesh.h"
 
@@ -19,7 +20,7 @@ namespace daylit::render {
 namespace {
 
 constexpr float kNear = 0.05f, kFar = 2000.0f;
-constexpr int kMaxLights = 16;  // as the object shader's
+constexpr int kMaxLights = relight::EnvLights::kMaxLights;
 
 // The background texture holds the frame with row 0 at the top; GL's window rows count upward.
 const char* kBackgroundFragment = R"(#version 330 core
@@ -285,7 +286,6 @@ struct Compositor::Gl {
   GlTexture shadow_map = NewTexture();
   // The lights' shadow maps (CompositeInput::lights): one layer each, for `light_generation`.
   GlTexture light_maps = NewTexture();
-  int light_layers = 0;
   int light_generation = -1;
   std::vector<glm::mat4> light_shadow_from_world;
   std::vector<float> light_texel;
@@ -370,6 +370,13 @@ Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& optio
   glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, g.shadow_map.get(), 0);
   glDrawBuffer(GL_NONE);
   glReadBuffer(GL_NONE);
+  // The lights' shadow maps, a layer each.
+  if (options.lights > 0) {
+    glBindTexture(GL_TEXTURE_2D_ARRAY, g.light_maps.get());
+    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT24, options.light_shadow_map_size, options.light_shadow_map_size,
+                 options.lights, 0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+    SetShadowSampling(GL_TEXTURE_2D_ARRAY);
+  }
   glBindTexture(GL_TEXTURE_2D, g.background_texture.get());
   glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, rw, rh, 0, GL_RGB, GL_FLOAT, nullptr);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
@@ -424,15 +431,9 @@ void Compositor::Render(const CompositeInput& input, float* image) {
   }
   if (light_count > 0 && input.lights_generation != g.light_generation) {
     const int size = g.options.light_shadow_map_size;
-    if (g.light_layers < light_count) {
-      glBindTexture(GL_TEXTURE_2D_ARRAY, g.light_maps.get());
-      glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT24, size, size, light_count, 0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
-      SetShadowSampling(GL_TEXTURE_2D_ARRAY);
-      g.light_layers = light_count;
-    }
     g.light_generation = input.lights_generation;
-    g.light_shadow_from_world.assign(kMaxLights, glm::mat4(1.0f));
-    g.light_texel.assign(kMaxLights, 0.0f);
+    g.light_shadow_from_world.resize(static_cast<size_t>(light_count));
+    g.light_texel.resize(static_cast<size_t>(light_count));
     glBindFramebuffer(GL_FRAMEBUFFER, g.shadow.get());
     for (int i = 0; i < light_count; ++i) {
       const glm::vec3 dir = glm::normalize(input.lights->lights[i].direction);

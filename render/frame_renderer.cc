@@ -26,7 +26,7 @@ FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& b
       compositor_(scene, CompositorFor(options, scene)),
       linearizer_(scene.response) {
   scene::CheckObjectsOutsideModel(objects_model_, caster, scene.file.string());
-  if (!bake.gather.directions.empty()) {
+  if (options.lights == 0 && !bake.gather.directions.empty()) {
     volume_ = std::make_unique<relight::IrradianceVolume>(bake.gather, relight::ProbesInsideModel(bake.gather, caster));
   }
   if (options.lights > 0 && !scene.objects.empty()) {
@@ -72,30 +72,29 @@ void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcas
   const relight::LightParts e = relight::SplitLight(light, overcast_share);
   if (volume_ || env_lights_) {
     if (bounce_.SetSun(sun_dir)) compositor_.SetObjectLosses(bounce_.sun_loss(), bounce_.sky_loss());
-  }
-  if (env_lights_) {
-    // The relit map's lights: fitted when the sun moves or the light changes much, else each
-    // part's irradiances combined.
+    // The relit map is linear in E_sun, E_clear and E_overcast, and so are the volume and the
+    // lights' irradiances: the three parts are made when the sun moves, and each frame only
+    // combines them.
     if (relighter_.SetSun(sun_dir)) {
       relighter_.Basis(&basis_);
       shadows_.SetEnvBasis(basis_);
-      env_lights_->SetBasis(basis_);
+      if (env_lights_) {
+        env_lights_->SetBasis(basis_);
+      } else {
+        const std::vector<glm::vec3>* maps[3] = {&basis_.sun, &basis_.clear, &basis_.overcast};
+        for (size_t i = 0; i < 3; ++i) {
+          volume_->Update(*maps[i]);
+          volume_parts_[i] = volume_->coefficients();
+        }
+      }
     }
+  }
+  if (env_lights_) {
+    // The lights are fitted again when the combination has drifted too far (relight::EnvLights).
     input.lights = &env_lights_->Update(e);
     input.lights_reflected = &env_lights_->reflected();
     input.lights_generation = env_lights_->generation();
   } else if (volume_) {
-    // The relit map is linear in E_sun, E_clear and E_overcast, and so is the volume: the three
-    // parts are recomputed when the sun moves, and each frame only combines them.
-    if (relighter_.SetSun(sun_dir)) {
-      relighter_.Basis(&basis_);
-      shadows_.SetEnvBasis(basis_);
-      const std::vector<glm::vec3>* maps[3] = {&basis_.sun, &basis_.clear, &basis_.overcast};
-      for (size_t i = 0; i < 3; ++i) {
-        volume_->Update(*maps[i]);
-        volume_parts_[i] = volume_->coefficients();
-      }
-    }
     volume_->SetCombination({&volume_parts_[0], &volume_parts_[1], &volume_parts_[2]}, {e.sun, e.clear, e.overcast});
     input.volume = volume_.get();
   }

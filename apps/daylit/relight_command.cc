@@ -73,10 +73,6 @@ glm::dvec3 RgbOption(const std::vector<double>& v, const char* option) {
   return {v[0], v[1], v[2]};
 }
 
-bool HasEstimate(const estimation::SunSky& light) {
-  return light.sky_rgb.x + light.sky_rgb.y + light.sky_rgb.z > 0.0;
-}
-
 // The light a frame is relit to, from its own (`now`, the estimate) and the options.
 estimation::SunSky NewLight(const RelightOptions& o, const Target& target, const estimation::SunSky& now,
                             double now_elevation_deg) {
@@ -262,7 +258,7 @@ void RunRelight(const RelightOptions& o) {
         return;
       }
       std::vector<float> image = writer.TakeBuffer();
-      if (!HasEstimate(row.light)) {  // no usable fit yet: written as it is
+      if (!row.HasEstimate()) {  // no usable fit yet: written as it is
         ++unrelit;
         capture::LinearRadiance(frame, linearizer, &image);
       } else {

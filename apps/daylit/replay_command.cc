@@ -257,7 +257,7 @@ void RunReplay(const ReplayOptions& o) {
     // Relit to the slider's time: the frame times E_new / E_now, the objects under the new sun.
     std::optional<scene::SceneSun> relit_sun;
     const std::optional<UtcTime> relit_to = slider.Target(row.time_utc);
-    if (relit_to && row.light.sky_rgb.x + row.light.sky_rgb.y + row.light.sky_rgb.z > 0.0) {
+    if (relit_to && row.HasEstimate()) {
       relit_sun = scene::SunAt(scene, *relit_to);
       const glm::vec3 next_sun(relit_sun->dir);
       if (relighter == nullptr) relighter = std::make_unique<relight::ImageRelighter>(scene, baked, caster);
