@@ -143,16 +143,18 @@ bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
   std::erase_if(affected_, [](const Affected& a) { return !a.covers; });
   std::vector<uint8_t> listed(gbuffer_.point.size(), 0);
   for (const Affected& a : affected_) listed[a.pixel] = 1;
-  std::vector<uint32_t> passing;  // facing the sun, sun ray through an object's sphere
+  // Only a point whose sun rays can pass an object's bounding sphere (widened by more than the
+  // disc's radius) can lose sun to it.
+  const auto sun_may_meet_object = [&](const glm::vec3& origin) {
+    for (const glm::vec4& s : spheres_) {
+      if (RayMeetsSphere(origin, sun, glm::vec4(glm::vec3(s), s.w + 0.01f * glm::distance(origin, glm::vec3(s))))) return true;
+    }
+    return false;
+  };
+  std::vector<uint32_t> passing;  // not listed yet, facing the sun, sun ray through an object's sphere
   for (size_t p = 0; p < gbuffer_.point.size(); ++p) {
     if (gbuffer_.surface[p] == bake::kNoSurface || listed[p] || glm::dot(gbuffer_.normal[p], sun) <= 0.0f) continue;
-    const glm::vec3 origin = gbuffer_.point[p] + options_.offset_m * gbuffer_.normal[p];
-    for (const glm::vec4& s : spheres_) {
-      if (RayMeetsSphere(origin, sun, glm::vec4(glm::vec3(s), s.w + 0.01f * glm::distance(origin, glm::vec3(s))))) {
-        passing.push_back(static_cast<uint32_t>(p));
-        break;
-      }
-    }
+    if (sun_may_meet_object(gbuffer_.point[p] + options_.offset_m * gbuffer_.normal[p])) passing.push_back(static_cast<uint32_t>(p));
   }
   for (const uint32_t p : passing) {
     affected_.push_back(Affected{p});
@@ -164,21 +166,18 @@ bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
       const glm::vec3 n = gbuffer_.normal[a.pixel];
       const glm::vec3 origin = gbuffer_.point[a.pixel] + options_.offset_m * n;
       a.cos_sun = std::max(0.0f, glm::dot(n, sun));
-      // The sun is a disc: the share of it each point sees gives the penumbrae.
-      int real_visible = 0, both_visible = 0;
-      if (a.cos_sun > 0.0f) {
-        for (const glm::vec3& d : disc_) {
-          if (real_.Occluded(origin, d)) continue;
-          ++real_visible;
-          if (!objects_.Occluded(origin, d)) ++both_visible;
-        }
+      // The sun is a disc: the share of it the objects newly hide gives the penumbrae. A ray
+      // counts when an object stops it and the real model does not (no double darkening); the
+      // objects' few triangles are asked first.
+      int lost = 0;
+      if (a.cos_sun > 0.0f && sun_may_meet_object(origin)) {
+        for (const glm::vec3& d : disc_) lost += objects_.Occluded(origin, d) && !real_.Occluded(origin, d) ? 1 : 0;
       }
-      a.sun_real = static_cast<float>(real_visible) / static_cast<float>(disc_.size());
-      a.sun_with = static_cast<float>(both_visible) / static_cast<float>(disc_.size());
+      a.sun_lost = static_cast<float>(lost) / static_cast<float>(disc_.size());
     }
   });
   // Shadow-only pixels the objects do not shade after all are dropped; order by pixel.
-  std::erase_if(affected_, [](const Affected& a) { return !a.covers && a.sun_with == a.sun_real; });
+  std::erase_if(affected_, [](const Affected& a) { return !a.covers && a.sun_lost == 0.0f; });
   std::sort(affected_.begin(), affected_.end(), [](const Affected& a, const Affected& b) { return a.pixel < b.pixel; });
   return true;
 }
@@ -205,7 +204,7 @@ void ObjectShadows::Apply(const estimation::SunSky& light, double overcast_share
   tbb::parallel_for(tbb::blocked_range<size_t>(0, affected_.size(), 2048), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
       const Affected& a = affected_[i];
-      glm::vec3 lost = e.sun * (a.cos_sun * (a.sun_real - a.sun_with));
+      glm::vec3 lost = e.sun * (a.cos_sun * a.sun_lost);
       if (a.covers) {
         lost += has_basis_ ? e.sun * a.covered_sun + e.clear * a.covered_clear + e.overcast * a.covered_overcast : sky * a.sky_lost;
       }
@@ -239,7 +238,7 @@ size_t ObjectShadows::SkyLossPixels() const {
 }
 
 size_t ObjectShadows::ShadowPixels() const {
-  return static_cast<size_t>(std::count_if(affected_.begin(), affected_.end(), [](const Affected& a) { return a.sun_with != a.sun_real; }));
+  return static_cast<size_t>(std::count_if(affected_.begin(), affected_.end(), [](const Affected& a) { return a.sun_lost > 0.0f; }));
 }
 
 }  // namespace daylit::relight

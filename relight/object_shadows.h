@@ -70,8 +70,8 @@ class ObjectShadows {
     bool covers = false;     // an object covers some of the point's hemisphere
     float sky_lost = 0.0f;   // share of the cosine-weighted sky the objects cover
     uint32_t first = 0, count = 0;  // its covered rays' env texels in covered_texels_
-    float sun_real = 0.0f;   // s: the share of the sun's disc the point sees past the real model
-    float sun_with = 0.0f;   // s': the same past the objects too
+    float sun_lost = 0.0f;   // s − s': the share of the sun's disc the point sees past the real
+                             // model (s) but not past the objects too (s')
     uint32_t neighbours = 0;  // bit (dy + 2)·5 + dx + 2: the 5×5 neighbour is on the frame and the same surface
     glm::vec3 covered_sun{0.0f}, covered_clear{0.0f}, covered_overcast{0.0f};  // ray_weight·Σ basis over covered rays
   };

@@ -22,16 +22,6 @@ namespace {
 constexpr float kNear = 0.05f, kFar = 2000.0f;
 constexpr int kMaxLights = relight::EnvLights::kMaxLights;
 
-// The background texture holds the frame with row 0 at the top; GL's window rows count upward.
-const char* kBackgroundFragment = R"(#version 330 core
-uniform sampler2D background;
-uniform int height;
-out vec4 color;
-void main() {
-  ivec2 p = ivec2(gl_FragCoord.xy);
-  color = vec4(texelFetch(background, ivec2(p.x, height - 1 - p.y), 0).rgb, 1.0);
-})";
-
 const char* kDepthVertex = R"(#version 330 core
 layout(location = 0) in vec3 position;
 uniform mat4 clip_from_world;
@@ -273,14 +263,11 @@ struct Compositor::Gl {
   glm::vec3 shadow_sun{0.0f};
   glm::mat4 shadow_from_world{1.0f};
   float shadow_texel = 0.0f;
-  GlProgram background{kFullScreenTriangle, kBackgroundFragment};
   GlProgram depth{kDepthVertex, kDepthFragment};
   std::unique_ptr<GlProgram> object_program;  // ObjectFragment(options.lights)
-  GlVertexArray empty_vao = NewVertexArray();
   DrawMesh model;
   std::vector<DrawMesh> objects;
   glm::vec3 objects_lo{1e30f}, objects_hi{-1e30f}, model_lo{0.0f}, model_hi{0.0f};
-  GlTexture background_texture = NewTexture();
   GlFramebuffer msaa = NewFramebuffer(), resolved = NewFramebuffer(), shadow = NewFramebuffer();
   GlRenderbuffer msaa_color = NewRenderbuffer(), msaa_depth = NewRenderbuffer(), resolved_color = NewRenderbuffer();
   GlTexture shadow_map = NewTexture();
@@ -377,10 +364,6 @@ Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& optio
                  options.lights, 0, GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
     SetShadowSampling(GL_TEXTURE_2D_ARRAY);
   }
-  glBindTexture(GL_TEXTURE_2D, g.background_texture.get());
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, rw, rh, 0, GL_RGB, GL_FLOAT, nullptr);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   if (glGetError() != GL_NO_ERROR) ThrowInputError("OpenGL: setting up the compositor failed");
 }
@@ -469,24 +452,14 @@ void Compositor::Render(const CompositeInput& input, float* image) {
     }
     glBindBuffer(GL_ARRAY_BUFFER, 0);
   }
-  // Background, phantom, objects.
+  // The phantom and the objects over transparent black: the resolved alpha is each pixel's
+  // object coverage, its colour the covered samples' sum over all samples, so the frame is
+  // blended in below as MSAA over a drawn background would (every sample of a pixel shows the
+  // same background) without drawing, uploading or resolving the background.
   glBindFramebuffer(GL_FRAMEBUFFER, g.msaa.get());
   glViewport(0, 0, r.width, r.height);
-  glClear(GL_DEPTH_BUFFER_BIT);
-  glDisable(GL_DEPTH_TEST);
-  glDepthMask(GL_FALSE);
-  glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, g.background_texture.get());
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glPixelStorei(GL_UNPACK_ROW_LENGTH, g.width);
-  glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, r.width, r.height, GL_RGB, GL_FLOAT,
-                  image + (static_cast<size_t>(r.y) * g.width + r.x) * 3);
-  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-  glUseProgram(g.background.id());
-  glUniform1i(g.background.Uniform("background"), 0);
-  glUniform1i(g.background.Uniform("height"), r.height);
-  glBindVertexArray(g.empty_vao.get());
-  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
   glDepthMask(GL_TRUE);
   glDepthFunc(GL_LESS);
@@ -529,18 +502,23 @@ void Compositor::Render(const CompositeInput& input, float* image) {
     glDisable(GL_CULL_FACE);
   }
   glBindVertexArray(0);
-  // Resolve, and read back into the image's rectangle, top row first.
+  // Resolve, read back, and blend over the image's rectangle, top row first.
   glBindFramebuffer(GL_READ_FRAMEBUFFER, g.msaa.get());
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g.resolved.get());
   glBlitFramebuffer(0, 0, r.width, r.height, 0, 0, r.width, r.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, g.resolved.get());
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  const size_t row = static_cast<size_t>(r.width) * 3;
+  const size_t row = static_cast<size_t>(r.width) * 4;
   g.readback.resize(row * static_cast<size_t>(r.height));
-  glReadPixels(0, 0, r.width, r.height, GL_RGB, GL_FLOAT, g.readback.data());
+  glReadPixels(0, 0, r.width, r.height, GL_RGBA, GL_FLOAT, g.readback.data());
   for (int y = 0; y < r.height; ++y) {
-    std::copy_n(g.readback.data() + static_cast<size_t>(r.height - 1 - y) * row, row,
-                image + (static_cast<size_t>(r.y + y) * g.width + r.x) * 3);
+    const float* drawn = g.readback.data() + static_cast<size_t>(r.height - 1 - y) * row;
+    float* out = image + (static_cast<size_t>(r.y + y) * g.width + r.x) * 3;
+    for (int x = 0; x < r.width; ++x, drawn += 4, out += 3) {
+      const float coverage = drawn[3];
+      if (coverage == 0.0f) continue;
+      for (int c = 0; c < 3; ++c) out[c] = drawn[c] + (1.0f - coverage) * out[c];
+    }
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }

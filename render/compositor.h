@@ -7,8 +7,9 @@
 //     map of the real model and the objects (so real walls shade objects, and objects each other
 //     and themselves), E_volume the SH9 irradiance volume: its coefficients trilinear at the
 //     vertices, interpolated across each triangle, evaluated with the fragment's normal;
-//   - 4× MSAA in RGBA32F, resolved and read back as linear floats.
-// Only the rectangle the objects project to is drawn, uploaded and read back (the rest of the
+//   - 4× MSAA in RGBA32F over transparent black, resolved, read back and blended over the frame
+//     by its coverage (as MSAA over the frame drawn first, without drawing it).
+// Only the rectangle the objects project to is drawn and read back (the rest of the
 // frame is the background as it was), and the sun's shadow map is redrawn only when the sun has
 // moved more than 0.05°.
 // Needs a current GL 3.3 core context (render/gl_context.h).
