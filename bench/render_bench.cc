@@ -16,6 +16,7 @@
 #include "render/image_relight_gl.h"
 #include "relight/env_lights.h"
 #include "relight/image_relight.h"
+#include "relight/object_shadows.h"
 #include "scene/object_mesh.h"
 #include "capture/frame_source.h"
 #include "scene/scene.h"
@@ -81,6 +82,53 @@ void BM_RenderFrame(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_RenderFrame)->Arg(0)->Arg(2)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The objects' shadows and sky loss on the real surfaces (relight::ObjectShadows), on the CPU:
+// per frame (B from the frame, the loss for its light; 310k of the 518k pixels on
+// courtyard-a), and per sun move (the sun rays past the objects' bounding spheres).
+struct CourtyardShadows {
+  scene::SceneModel model;
+  scene::RayCaster objects;
+  relight::ObjectShadows shadows;
+  std::vector<float> linear;
+
+  explicit CourtyardShadows(Courtyard& c)
+      : model(scene::ObjectsModel(c.scene.objects)), objects(model), shadows(c.scene, c.bake, *c.caster, objects) {
+    relight::EnvRelighter relighter(c.bake, glm::vec3(c.scene.envmap->position), *c.caster);
+    relighter.SetSun(c.fit.sun_dir);
+    relight::EnvBasis basis;
+    relighter.Basis(&basis);
+    shadows.SetEnvBasis(basis);
+    shadows.SetSun(c.fit.sun_dir);
+    capture::LinearRadiance(c.fit.frame, capture::Linearizer(c.scene.response), &linear);
+  }
+};
+
+void BM_ObjectShadows(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  CourtyardShadows s(c);
+  std::vector<float> image;
+  for (auto _ : state) {
+    image = s.linear;
+    s.shadows.Apply(c.fit.fit.light, c.fit.fit.overcast_share, image.data());
+    benchmark::DoNotOptimize(image.data());
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_ObjectShadows)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_ObjectShadowsSunMove(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  CourtyardShadows s(c);
+  int k = 0;
+  for (auto _ : state) {
+    const float turn = (++k % 2 ? 0.1f : -0.1f) * 0.0175f;
+    const glm::vec3 d = c.fit.sun_dir;
+    benchmark::DoNotOptimize(s.shadows.SetSun(
+        glm::vec3(d.x * std::cos(turn) - d.y * std::sin(turn), d.x * std::sin(turn) + d.y * std::cos(turn), d.z)));
+  }
+}
+BENCHMARK(BM_ObjectShadowsSunMove)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(6);
 
 // --lighting lights:N when the sun moves or the light changes much: the relit map's three parts
 // reprojected to the objects, their exact irradiance at the fit's normals, Irradiance

@@ -4,7 +4,6 @@
 #include <bit>
 #include <cmath>
 
-#include <opencv2/imgproc.hpp>
 #include <tbb/parallel_for.h>
 
 #include <glm/gtc/constants.hpp>
@@ -124,6 +123,7 @@ void ObjectShadows::SetEnvBasis(const EnvBasis& basis) {
     }
   });
   has_basis_ = true;
+  loss_ready_ = false;
 }
 
 bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
@@ -179,7 +179,28 @@ bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
   // Shadow-only pixels the objects do not shade after all are dropped; order by pixel.
   std::erase_if(affected_, [](const Affected& a) { return !a.covers && a.sun_lost == 0.0f; });
   std::sort(affected_.begin(), affected_.end(), [](const Affected& a, const Affected& b) { return a.pixel < b.pixel; });
+  loss_ready_ = false;
   return true;
+}
+
+void ObjectShadows::PrepareLoss() {
+  loss_.resize(affected_.size());
+  for (size_t i = 0; i < affected_.size(); ++i) {
+    const Affected& a = affected_[i];
+    Loss& l = loss_[i];
+    l.sun = glm::vec3(a.cos_sun * a.sun_lost), l.clear = l.overcast = glm::vec3(0.0f);
+    if (!a.covers) continue;
+    if (has_basis_) {
+      l.sun += a.covered_sun, l.clear = a.covered_clear, l.overcast = a.covered_overcast;
+    } else {
+      l.clear = l.overcast = glm::vec3(a.sky_lost);  // E_sky · the covered share
+    }
+  }
+  const uint32_t w = static_cast<uint32_t>(gbuffer_.width);
+  row_begin_.assign(static_cast<size_t>(gbuffer_.height) + 1, 0);
+  for (const Affected& a : affected_) ++row_begin_[a.pixel / w + 1];
+  for (size_t y = 1; y < row_begin_.size(); ++y) row_begin_[y] += row_begin_[y - 1];
+  loss_ready_ = true;
 }
 
 void ObjectShadows::Apply(const estimation::SunSky& light, double overcast_share, float* rgb) {
@@ -187,50 +208,62 @@ void ObjectShadows::Apply(const estimation::SunSky& light, double overcast_share
   // 5×5 neighbours on the same surface so that the camera's noise is not read as light. The
   // pixel then keeps the share (B − ΔB)/B of its own value, noise included. All B are read
   // before any pixel changes.
-  const int w = gbuffer_.width;
-  const LightParts e = SplitLight(light, overcast_share);
-  const glm::vec3 sky(light.sky_rgb);
-  keep_.resize(affected_.size());
   if (affected_.empty()) return;
-  // Where all 25 neighbours are on the pixel's surface (most pixels), B is a 5×5 box filter of
-  // π·L/ρ over the rows the affected pixels span.
-  const int h = gbuffer_.height;
-  const int row0 = std::max(0, static_cast<int>(affected_.front().pixel / static_cast<uint32_t>(w)) - 2);
-  const int row1 = std::min(h, static_cast<int>(affected_.back().pixel / static_cast<uint32_t>(w)) + 3);
-  const cv::Mat light_rows(row1 - row0, w, CV_32FC3, rgb + static_cast<size_t>(row0) * w * 3);
-  const cv::Mat weight_rows(row1 - row0, w, CV_32FC3, pi_over_albedo_.data() + static_cast<size_t>(row0) * w);
-  cv::multiply(light_rows, weight_rows, weighted_);
-  cv::boxFilter(weighted_, box_, -1, cv::Size(5, 5), cv::Point(-1, -1), true, cv::BORDER_CONSTANT);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, affected_.size(), 2048), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t i = range.begin(); i != range.end(); ++i) {
-      const Affected& a = affected_[i];
-      glm::vec3 lost = e.sun * (a.cos_sun * a.sun_lost);
-      if (a.covers) {
-        lost += has_basis_ ? e.sun * a.covered_sun + e.clear * a.covered_clear + e.overcast * a.covered_overcast : sky * a.sky_lost;
-      }
-      glm::vec3 b(0.0f);
-      if (a.neighbours == kAllNeighbours) {
-        const cv::Vec3f& mean = box_.at<cv::Vec3f>(static_cast<int>(a.pixel / static_cast<uint32_t>(w)) - row0,
-                                                   static_cast<int>(a.pixel % static_cast<uint32_t>(w)));
-        b = glm::vec3(mean[0], mean[1], mean[2]);
-      } else {
-        int n = 0;
-        for (uint32_t bits = a.neighbours; bits != 0; bits &= bits - 1) {
-          const int bit = std::countr_zero(bits);
-          const ptrdiff_t q = static_cast<ptrdiff_t>(a.pixel) + (bit / 5 - 2) * w + (bit % 5 - 2);
-          const float* l = rgb + 3 * q;
-          b += glm::vec3(l[0], l[1], l[2]) * pi_over_albedo_[static_cast<size_t>(q)];
-          ++n;
+  if (!loss_ready_) PrepareLoss();
+  const LightParts e = SplitLight(light, overcast_share);
+  const int w = gbuffer_.width, h = gbuffer_.height;
+  const size_t row_floats = 3 * static_cast<size_t>(w);
+  const float* weight = &pi_over_albedo_[0].x;
+  keep_.resize(affected_.size());
+  const int first_row = static_cast<int>(affected_.front().pixel / static_cast<uint32_t>(w));
+  const int last_row = static_cast<int>(affected_.back().pixel / static_cast<uint32_t>(w));
+  tbb::parallel_for(tbb::blocked_range<int>(first_row, last_row + 1, 16), [&](const tbb::blocked_range<int>& rows) {
+    // π·L/ρ over the block's rows and two more on each side; then, per row, its sums over five
+    // rows: where all 25 neighbours are on the pixel's surface (most pixels), B is five of those.
+    thread_local std::vector<float> weighted, column;
+    const int y0 = std::max(0, rows.begin() - 2), y1 = std::min(h, rows.end() + 2);
+    weighted.resize(static_cast<size_t>(y1 - y0) * row_floats);
+    column.resize(row_floats);
+    const size_t offset = static_cast<size_t>(y0) * row_floats;
+    for (size_t k = 0; k < weighted.size(); ++k) weighted[k] = rgb[offset + k] * weight[offset + k];
+    const auto weighted_at = [&](size_t q, int c) { return weighted[3 * q - offset + static_cast<size_t>(c)]; };
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      const uint32_t i0 = row_begin_[static_cast<size_t>(y)], i1 = row_begin_[static_cast<size_t>(y) + 1];
+      if (i0 == i1) continue;
+      if (y >= 2 && y + 2 < h) {
+        const float* r = weighted.data() + static_cast<size_t>(y - 2 - y0) * row_floats;
+        for (size_t k = 0; k < row_floats; ++k) {
+          column[k] = r[k] + r[k + row_floats] + r[k + 2 * row_floats] + r[k + 3 * row_floats] + r[k + 4 * row_floats];
         }
-        b /= static_cast<float>(std::max(n, 1));
       }
-      for (int c = 0; c < 3; ++c) keep_[i][c] = b[c] > 0.0f ? std::clamp(1.0f - lost[c] / b[c], 0.0f, 1.0f) : 1.0f;
+      for (uint32_t i = i0; i < i1; ++i) {
+        const Affected& a = affected_[i];
+        const Loss& l = loss_[i];
+        const glm::vec3 lost = e.sun * l.sun + e.clear * l.clear + e.overcast * l.overcast;
+        glm::vec3 b(0.0f);
+        if (a.neighbours == kAllNeighbours) {
+          const float* c = column.data() + 3 * static_cast<size_t>(a.pixel % static_cast<uint32_t>(w) - 2);
+          for (int k = 0; k < 3; ++k) b[k] = (c[k] + c[k + 3] + c[k + 6] + c[k + 9] + c[k + 12]) * (1.0f / 25.0f);
+        } else {
+          int n = 0;
+          for (uint32_t bits = a.neighbours; bits != 0; bits &= bits - 1) {
+            const int bit = std::countr_zero(bits);
+            const size_t q = static_cast<size_t>(static_cast<ptrdiff_t>(a.pixel) + (bit / 5 - 2) * w + (bit % 5 - 2));
+            b += glm::vec3(weighted_at(q, 0), weighted_at(q, 1), weighted_at(q, 2));
+            ++n;
+          }
+          b /= static_cast<float>(std::max(n, 1));
+        }
+        for (int c = 0; c < 3; ++c) keep_[i][c] = b[c] > 0.0f ? std::clamp(1.0f - lost[c] / b[c], 0.0f, 1.0f) : 1.0f;
+      }
     }
   });
-  for (size_t i = 0; i < affected_.size(); ++i) {
-    float* p = rgb + 3 * static_cast<size_t>(affected_[i].pixel);
-    for (int c = 0; c < 3; ++c) p[c] *= keep_[i][c];
-  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, affected_.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      float* p = rgb + 3 * static_cast<size_t>(affected_[i].pixel);
+      for (int c = 0; c < 3; ++c) p[c] *= keep_[i][c];
+    }
+  });
 }
 
 size_t ObjectShadows::SkyLossPixels() const {

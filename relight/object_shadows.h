@@ -21,7 +21,6 @@
 #include <vector>
 
 #include <glm/glm.hpp>
-#include <opencv2/core.hpp>
 
 #include "bake/bake.h"
 #include "estimation/lighting_model.h"
@@ -75,7 +74,13 @@ class ObjectShadows {
     uint32_t neighbours = 0;  // bit (dy + 2)·5 + dx + 2: the 5×5 neighbour is on the frame and the same surface
     glm::vec3 covered_sun{0.0f}, covered_clear{0.0f}, covered_overcast{0.0f};  // ray_weight·Σ basis over covered rays
   };
+  // What Apply combines with each frame's light: per affected pixel, the irradiance it loses per
+  // unit of E_sun, E_clear and E_overcast. Remade after the sun or the basis changed.
+  struct Loss {
+    glm::vec3 sun, clear, overcast;
+  };
   void FindNeighbours(Affected* a) const;
+  void PrepareLoss();
 
   const bake::CameraGBuffer& gbuffer_;
   const scene::RayCaster& real_;
@@ -87,8 +92,10 @@ class ObjectShadows {
   float ray_weight_ = 0.0f;         // π/N: E = ray_weight · Σ L over covered rays
   bool has_basis_ = false;
   std::vector<glm::vec3> pi_over_albedo_;  // per camera pixel: B = π·L/ρ
-  std::vector<glm::vec3> keep_;  // Apply's scratch
-  cv::Mat weighted_, box_;
+  std::vector<Loss> loss_;          // parallel to affected_
+  std::vector<uint32_t> row_begin_;  // per camera row (and one past): its first pixel in affected_
+  bool loss_ready_ = false;
+  std::vector<glm::vec3> keep_;      // Apply's scratch
   std::vector<glm::vec3> disc_;     // directions over the sun's disc
   glm::vec3 sun_{0.0f};
   bool has_sun_ = false;
