@@ -188,6 +188,7 @@ void ObjectShadows::PrepareLoss() {
   for (size_t i = 0; i < affected_.size(); ++i) {
     const Affected& a = affected_[i];
     Loss& l = loss_[i];
+    l.pixel = a.pixel, l.neighbours = a.neighbours;
     l.sun = glm::vec3(a.cos_sun * a.sun_lost), l.clear = l.overcast = glm::vec3(0.0f);
     if (!a.covers) continue;
     if (has_basis_) {
@@ -206,40 +207,39 @@ void ObjectShadows::PrepareLoss() {
 void ObjectShadows::Apply(const estimation::SunSky& light, double overcast_share, float* rgb) {
   // B, the irradiance each pixel shows, from the frame itself: π·L/ρ, averaged over the pixel's
   // 5×5 neighbours on the same surface so that the camera's noise is not read as light. The
-  // pixel then keeps the share (B − ΔB)/B of its own value, noise included. All B are read
-  // before any pixel changes.
+  // pixel then keeps the share (B − ΔB)/B of its own value, noise included.
   if (affected_.empty()) return;
   if (!loss_ready_) PrepareLoss();
   const LightParts e = SplitLight(light, overcast_share);
   const int w = gbuffer_.width, h = gbuffer_.height;
   const size_t row_floats = 3 * static_cast<size_t>(w);
+  const int first_row = static_cast<int>(loss_.front().pixel / static_cast<uint32_t>(w));
+  const int last_row = static_cast<int>(loss_.back().pixel / static_cast<uint32_t>(w));
+  // π·L/ρ over the rows the affected pixels span and two more on each side, all read before any
+  // pixel changes.
+  const int y0 = std::max(0, first_row - 2), y1 = std::min(h, last_row + 3);
+  const size_t offset = static_cast<size_t>(y0) * row_floats;
+  weighted_.resize(static_cast<size_t>(y1 - y0) * row_floats);
   const float* weight = &pi_over_albedo_[0].x;
-  keep_.resize(affected_.size());
-  const int first_row = static_cast<int>(affected_.front().pixel / static_cast<uint32_t>(w));
-  const int last_row = static_cast<int>(affected_.back().pixel / static_cast<uint32_t>(w));
-  tbb::parallel_for(tbb::blocked_range<int>(first_row, last_row + 1, 16), [&](const tbb::blocked_range<int>& rows) {
-    // π·L/ρ over the block's rows and two more on each side; then, per row, its sums over five
-    // rows: where all 25 neighbours are on the pixel's surface (most pixels), B is five of those.
-    thread_local std::vector<float> weighted, column;
-    const int y0 = std::max(0, rows.begin() - 2), y1 = std::min(h, rows.end() + 2);
-    weighted.resize(static_cast<size_t>(y1 - y0) * row_floats);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, weighted_.size(), 3 * 16384), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t k = range.begin(); k != range.end(); ++k) weighted_[k] = rgb[offset + k] * weight[offset + k];
+  });
+  tbb::parallel_for(tbb::blocked_range<int>(first_row, last_row + 1, 8), [&](const tbb::blocked_range<int>& rows) {
+    // Per row, the sums over five rows: where all 25 neighbours are on the pixel's surface (most
+    // pixels), B is five of them.
+    thread_local std::vector<float> column;
     column.resize(row_floats);
-    const size_t offset = static_cast<size_t>(y0) * row_floats;
-    for (size_t k = 0; k < weighted.size(); ++k) weighted[k] = rgb[offset + k] * weight[offset + k];
-    const auto weighted_at = [&](size_t q, int c) { return weighted[3 * q - offset + static_cast<size_t>(c)]; };
     for (int y = rows.begin(); y < rows.end(); ++y) {
       const uint32_t i0 = row_begin_[static_cast<size_t>(y)], i1 = row_begin_[static_cast<size_t>(y) + 1];
       if (i0 == i1) continue;
       if (y >= 2 && y + 2 < h) {
-        const float* r = weighted.data() + static_cast<size_t>(y - 2 - y0) * row_floats;
+        const float* r = weighted_.data() + static_cast<size_t>(y - 2 - y0) * row_floats;
         for (size_t k = 0; k < row_floats; ++k) {
           column[k] = r[k] + r[k + row_floats] + r[k + 2 * row_floats] + r[k + 3 * row_floats] + r[k + 4 * row_floats];
         }
       }
       for (uint32_t i = i0; i < i1; ++i) {
-        const Affected& a = affected_[i];
-        const Loss& l = loss_[i];
-        const glm::vec3 lost = e.sun * l.sun + e.clear * l.clear + e.overcast * l.overcast;
+        const Loss& a = loss_[i];
         glm::vec3 b(0.0f);
         if (a.neighbours == kAllNeighbours) {
           const float* c = column.data() + 3 * static_cast<size_t>(a.pixel % static_cast<uint32_t>(w) - 2);
@@ -248,20 +248,16 @@ void ObjectShadows::Apply(const estimation::SunSky& light, double overcast_share
           int n = 0;
           for (uint32_t bits = a.neighbours; bits != 0; bits &= bits - 1) {
             const int bit = std::countr_zero(bits);
-            const size_t q = static_cast<size_t>(static_cast<ptrdiff_t>(a.pixel) + (bit / 5 - 2) * w + (bit % 5 - 2));
-            b += glm::vec3(weighted_at(q, 0), weighted_at(q, 1), weighted_at(q, 2));
+            const float* q = weighted_.data() + 3 * static_cast<size_t>(static_cast<ptrdiff_t>(a.pixel) + (bit / 5 - 2) * w + (bit % 5 - 2)) - offset;
+            b += glm::vec3(q[0], q[1], q[2]);
             ++n;
           }
           b /= static_cast<float>(std::max(n, 1));
         }
-        for (int c = 0; c < 3; ++c) keep_[i][c] = b[c] > 0.0f ? std::clamp(1.0f - lost[c] / b[c], 0.0f, 1.0f) : 1.0f;
+        const glm::vec3 lost = e.sun * a.sun + e.clear * a.clear + e.overcast * a.overcast;
+        float* p = rgb + 3 * static_cast<size_t>(a.pixel);
+        for (int c = 0; c < 3; ++c) p[c] *= b[c] > 0.0f ? std::clamp(1.0f - lost[c] / b[c], 0.0f, 1.0f) : 1.0f;
       }
-    }
-  });
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, affected_.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t i = range.begin(); i != range.end(); ++i) {
-      float* p = rgb + 3 * static_cast<size_t>(affected_[i].pixel);
-      for (int c = 0; c < 3; ++c) p[c] *= keep_[i][c];
     }
   });
 }

@@ -74,9 +74,10 @@ class ObjectShadows {
     uint32_t neighbours = 0;  // bit (dy + 2)·5 + dx + 2: the 5×5 neighbour is on the frame and the same surface
     glm::vec3 covered_sun{0.0f}, covered_clear{0.0f}, covered_overcast{0.0f};  // ray_weight·Σ basis over covered rays
   };
-  // What Apply combines with each frame's light: per affected pixel, the irradiance it loses per
+  // What Apply reads of each affected pixel (in the same order): the irradiance it loses per
   // unit of E_sun, E_clear and E_overcast. Remade after the sun or the basis changed.
   struct Loss {
+    uint32_t pixel, neighbours;
     glm::vec3 sun, clear, overcast;
   };
   void FindNeighbours(Affected* a) const;
@@ -92,10 +93,10 @@ class ObjectShadows {
   float ray_weight_ = 0.0f;         // π/N: E = ray_weight · Σ L over covered rays
   bool has_basis_ = false;
   std::vector<glm::vec3> pi_over_albedo_;  // per camera pixel: B = π·L/ρ
-  std::vector<Loss> loss_;          // parallel to affected_
+  std::vector<Loss> loss_;          // one per affected_, in its order
   std::vector<uint32_t> row_begin_;  // per camera row (and one past): its first pixel in affected_
   bool loss_ready_ = false;
-  std::vector<glm::vec3> keep_;      // Apply's scratch
+  std::vector<float> weighted_;      // Apply's π·L/ρ
   std::vector<glm::vec3> disc_;     // directions over the sun's disc
   glm::vec3 sun_{0.0f};
   bool has_sun_ = false;
