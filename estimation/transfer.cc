@@ -94,13 +94,24 @@ void LightTransfer::Trace(const std::vector<uint32_t>& pixels) {
     return b;
   };
   tbb::parallel_for(tbb::blocked_range<size_t>(0, fresh.size(), kGrain), [&](const tbb::blocked_range<size_t>& range) {
+    thread_local std::vector<glm::vec3> dirs;
+    thread_local std::vector<scene::RayHit> hits;
     for (size_t k = range.begin(); k != range.end(); ++k) {
       const uint32_t p = fresh[k];
       const glm::vec3 origin = points_.point[p] + options_.offset_m * points_.normal[p];
       const glm::mat3 frame = bake::HemisphereFrame(points_.normal[p], p);
-      for (const glm::vec3& d : hemisphere_) {
-        const glm::vec3 dir = frame * d;
-        const scene::RayHit hit = caster_.Intersect(origin, dir);
+      dirs.resize(hemisphere_.size()), hits.resize(hemisphere_.size());
+      for (size_t r = 0; r < dirs.size(); ++r) dirs[r] = frame * hemisphere_[r];
+      caster_.IntersectFrom(origin, dirs.data(), dirs.size(), 0.0f, hits.data());
+      size_t low_sky = 0, blocked = 0, bounces = 0;  // sized once
+      for (size_t r = 0; r < dirs.size(); ++r) {
+        low_sky += !hits[r].IsHit() && dirs[r].z <= 0.0f, blocked += hits[r].IsHit() && dirs[r].z > 0.0f;
+        bounces += hits[r].IsHit() && options_.interreflection;
+      }
+      local[k].low_sky.reserve(low_sky), local[k].blocked.reserve(blocked), local[k].bounces.reserve(bounces);
+      for (size_t r = 0; r < dirs.size(); ++r) {
+        const glm::vec3& dir = dirs[r];
+        const scene::RayHit& hit = hits[r];
         if (!hit.IsHit()) {
           if (dir.z <= 0.0f) local[k].low_sky.push_back(dir);
           continue;
@@ -241,14 +252,26 @@ void LightTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec3
   // terms for the per-surface means of the second.
   std::vector<Transfer> reflected(pixels.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels.size(), kGrain), [&](const tbb::blocked_range<size_t>& range) {
+    // The bounce points' shadow rays all run along the sun: traced per pixel as packets.
+    thread_local std::vector<glm::vec3> origins;
+    thread_local std::vector<uint32_t> facing;
+    thread_local std::vector<uint8_t> occluded;
     for (size_t k = range.begin(); k != range.end(); ++k) {
       const uint32_t p = pixels[k];
       const Paths& paths = paths_[static_cast<size_t>(slot_[p])];
       Transfer t, r;
+      origins.clear(), facing.clear();
+      for (uint32_t i = paths.bounce_begin; day && i < paths.bounce_end; ++i) {
+        if (glm::dot(bounces_[i].normal, sun_dir) > 0.0f) origins.push_back(bounces_[i].point), facing.push_back(i);
+      }
+      occluded.resize(origins.size());
+      caster_.OccludedAlong(origins.data(), origins.size(), sun_dir, 0.0f, occluded.data());
+      for (size_t j = 0; j < facing.size(); ++j) {
+        const Bounce& b = bounces_[facing[j]];
+        if (!occluded[j]) r.sun += b.albedo * glm::dot(b.normal, sun_dir);
+      }
       for (uint32_t i = paths.bounce_begin; i < paths.bounce_end; ++i) {
         const Bounce& b = bounces_[i];
-        const float cos_sun = glm::dot(b.normal, sun_dir);
-        if (day && cos_sun > 0.0f && !caster_.Occluded(b.point, sun_dir)) r.sun += b.albedo * cos_sun;
         r.overcast += b.albedo * b.sky_visibility;
         r.clear += b.albedo * b.sky_visibility * (clear_sky ? clear_weight(b.orientation) : glm::vec3(1.0f));
       }

@@ -4,6 +4,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -82,24 +83,57 @@ RayCaster::RayCaster(const SceneModel& model) : model_(model), embree_(std::make
 
 RayCaster::~RayCaster() = default;
 
+namespace {
+
+// A hit as RayHit: the model's triangle and surface, the normal turned toward the origin.
+RayHit HitOf(const SceneModel& model, const std::vector<uint32_t>& triangle_of_primitive, uint32_t prim, float t,
+             const glm::vec3& ng, const glm::vec3& dir) {
+  RayHit hit;
+  hit.t = t;
+  hit.triangle = triangle_of_primitive[prim];
+  hit.surface = model.triangles[hit.triangle].surface;
+  const glm::vec3 n = glm::normalize(ng);
+  hit.back_face = glm::dot(n, dir) > 0.0f;
+  hit.normal = hit.back_face ? -n : n;
+  return hit;
+}
+
+}  // namespace
+
 RayHit RayCaster::Intersect(const glm::vec3& origin, const glm::vec3& dir, float t_near, float t_far) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit r = MakeRay(origin, dir, t_near, t_far);
   rtcIntersect1(embree_->scene, &context, &r);
-  RayHit hit;
-  if (r.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-    hit.t = -1.0f;
-    return hit;
+  if (r.hit.geomID == RTC_INVALID_GEOMETRY_ID) return RayHit{-1.0f};
+  return HitOf(model_, triangle_of_primitive_, r.hit.primID, r.ray.tfar, glm::vec3(r.hit.Ng_x, r.hit.Ng_y, r.hit.Ng_z), dir);
+}
+
+void RayCaster::IntersectFrom(const glm::vec3& origin, const glm::vec3* dirs, size_t count, float t_near,
+                              RayHit* hits) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  alignas(64) RTCRayHit16 packet;
+  alignas(64) int valid[16];
+  for (size_t begin = 0; begin < count; begin += 16) {
+    const size_t n = std::min<size_t>(16, count - begin);
+    for (size_t i = 0; i < 16; ++i) {
+      const glm::vec3& d = dirs[begin + std::min(i, n - 1)];
+      valid[i] = i < n ? -1 : 0;
+      packet.ray.org_x[i] = origin.x, packet.ray.org_y[i] = origin.y, packet.ray.org_z[i] = origin.z;
+      packet.ray.dir_x[i] = d.x, packet.ray.dir_y[i] = d.y, packet.ray.dir_z[i] = d.z;
+      packet.ray.tnear[i] = t_near, packet.ray.tfar[i] = 1e30f, packet.ray.time[i] = 0.0f;
+      packet.ray.mask[i] = 0xFFFFFFFFu, packet.ray.id[i] = 0, packet.ray.flags[i] = 0;
+      packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID, packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, embree_->scene, &context, &packet);
+    for (size_t i = 0; i < n; ++i) {
+      hits[begin + i] = packet.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID
+                            ? RayHit{-1.0f}
+                            : HitOf(model_, triangle_of_primitive_, packet.hit.primID[i], packet.ray.tfar[i],
+                                    glm::vec3(packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i]), dirs[begin + i]);
+    }
   }
-  hit.t = r.ray.tfar;
-  hit.triangle = triangle_of_primitive_[r.hit.primID];
-  hit.surface = model_.triangles[hit.triangle].surface;
-  glm::vec3 n(r.hit.Ng_x, r.hit.Ng_y, r.hit.Ng_z);
-  n = glm::normalize(n);
-  hit.back_face = glm::dot(n, dir) > 0.0f;
-  hit.normal = hit.back_face ? -n : n;
-  return hit;
 }
 
 bool RayCaster::Occluded(const glm::vec3& origin, const glm::vec3& dir, float t_near, float t_far) const {
@@ -129,6 +163,28 @@ void RayCaster::OccludedMany(const glm::vec3* origins, const glm::vec3* dirs, si
       occluded[i] = ray.tfar < 0.0f ? 1 : 0;
     }
   });
+}
+
+void RayCaster::OccludedAlong(const glm::vec3* origins, size_t count, const glm::vec3& dir, float t_near,
+                              uint8_t* occluded) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  alignas(64) RTCRay16 packet;
+  alignas(64) int valid[16];
+  for (size_t begin = 0; begin < count; begin += 16) {
+    const size_t n = std::min<size_t>(16, count - begin);
+    for (size_t i = 0; i < 16; ++i) {
+      const glm::vec3& o = origins[begin + std::min(i, n - 1)];
+      valid[i] = i < n ? -1 : 0;
+      packet.org_x[i] = o.x, packet.org_y[i] = o.y, packet.org_z[i] = o.z;
+      packet.dir_x[i] = dir.x, packet.dir_y[i] = dir.y, packet.dir_z[i] = dir.z;
+      packet.tnear[i] = t_near, packet.tfar[i] = 1e30f, packet.time[i] = 0.0f;
+      packet.mask[i] = 0xFFFFFFFFu, packet.id[i] = 0, packet.flags[i] = 0;
+    }
+    rtcOccluded16(valid, embree_->scene, &context, &packet);
+    for (size_t i = 0; i < n; ++i) occluded[begin + i] = packet.tfar[i] < 0.0f ? 1 : 0;
+  }
 }
 
 }  // namespace daylit::scene
