@@ -20,7 +20,7 @@ ObjectBounce::ObjectBounce(const scene::Scene& scene, const bake::SceneBake& bak
   }
   std::vector<glm::vec3> positions, normals;
   for (const scene::VirtualObject& o : scene.objects) {
-    const scene::Mesh m = scene::ObjectMesh(o);
+    const scene::Mesh m = scene::ShadingMesh(o, scene);
     positions.insert(positions.end(), m.positions.begin(), m.positions.end());
     normals.insert(normals.end(), m.normals.begin(), m.normals.end());
   }

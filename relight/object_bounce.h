@@ -1,7 +1,7 @@
 // The light a virtual object loses because it shades the real ground around it. The irradiance
 // volume sees the real scene as the camera does, without the objects, so an object's underside
 // would get the sunlit ground's bounce even where the object's own shadow lies. Per vertex of
-// each object (scene::ObjectMesh order), cosine-weighted rays find the real points y it sees;
+// each object (scene::ShadingMesh order), cosine-weighted rays find the real points y it sees;
 // their radiance drops by ρ_y/π (E_sun cos_y (s_y − s'_y) + E_sky ΔV_y), where s' and ΔV are the
 // sun and sky the objects take from y (as in ObjectShadows). The vertex's irradiance then drops
 // by E_sun·A_sun + E_sky·A_sky with, over its N rays,

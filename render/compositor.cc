@@ -322,7 +322,7 @@ Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& optio
   scene.model.Bounds(&g.model_lo, &g.model_hi);
   std::vector<glm::vec3> all_vertices;
   for (const scene::VirtualObject& o : scene.objects) {
-    const scene::Mesh mesh = scene::ObjectMesh(o);
+    const scene::Mesh mesh = scene::ShadingMesh(o, scene);
     g.objects.push_back(Upload(mesh.positions, &mesh.normals, mesh.indices));
     g.objects.back().albedo = glm::vec3(o.albedo.value_or(glm::dvec3(0.5)));
     for (const glm::vec3& p : mesh.positions) g.objects_lo = glm::min(g.objects_lo, p), g.objects_hi = glm::max(g.objects_hi, p);
@@ -371,11 +371,13 @@ Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& optio
 Compositor::~Compositor() = default;
 
 void Compositor::SetObjectLosses(const std::vector<glm::vec3>& sun_loss, const std::vector<glm::vec3>& sky_loss) {
+  size_t vertices = 0;
+  for (const DrawMesh& m : gl_->objects) vertices += m.vertices;
+  if (sun_loss.size() != vertices || sky_loss.size() != vertices) {
+    ThrowInputError("SetObjectLosses: {} and {} values for {} vertices (scene::ShadingMesh)", sun_loss.size(), sky_loss.size(), vertices);
+  }
   size_t offset = 0;
   for (const DrawMesh& m : gl_->objects) {
-    if (offset + m.vertices > sun_loss.size() || offset + m.vertices > sky_loss.size()) {
-      ThrowInputError("SetObjectLosses: {} values for {}+ vertices", sun_loss.size(), offset + m.vertices);
-    }
     glBindBuffer(GL_ARRAY_BUFFER, m.sun_loss.get());
     glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(m.vertices * sizeof(glm::vec3)), sun_loss.data() + offset);
     glBindBuffer(GL_ARRAY_BUFFER, m.sky_loss.get());

@@ -58,7 +58,7 @@ class Compositor {
   int height() const;
 
   // The irradiance each object vertex loses per unit E_sun and per unit E_sky, all objects in
-  // scene::ObjectMesh order (relight::ObjectBounce); applied with the volume's light.
+  // scene::ShadingMesh order (relight::ObjectBounce); applied with the volume's light.
   void SetObjectLosses(const std::vector<glm::vec3>& sun_loss, const std::vector<glm::vec3>& sky_loss);
 
   // Draws the objects into `image`: camera-size linear RGB, row-major from the top row, holding

@@ -1,5 +1,6 @@
 #include "scene/object_mesh.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -219,10 +220,24 @@ Mesh LoadGltfMesh(const std::filesystem::path& path) {
 
 }  // namespace
 
-Mesh ObjectMesh(const VirtualObject& object) {
+// Below 48 slices (7.5° a facet) the interpolated normals of a small sphere stray enough to show
+// in its shading (percents of n·l), whatever its size in pixels.
+constexpr int kMinShadingSlices = 48;
+
+Mesh ShadingMesh(const VirtualObject& object, const Scene& scene) {
+  if (object.kind != MeshKind::kSphere) return ObjectMesh(object);
+  const double r = object.radius * std::max({object.scale.x, object.scale.y, object.scale.z});
+  const double depth = (scene.cam_from_world.rotation * object.position + scene.cam_from_world.translation).z - r;
+  if (!(depth > 1e-3)) return ObjectMesh(object);  // reaching the camera: the full mesh
+  const double r_px = std::max(scene.intrinsics.fx, scene.intrinsics.fy) * r / depth;
+  const int n = r_px <= 0.1 ? 0 : static_cast<int>(std::ceil(glm::pi<double>() / std::acos(1.0 - 0.1 / r_px)));
+  return ObjectMesh(object, std::clamp(n + n % 2, kMinShadingSlices, kSphereSlices));
+}
+
+Mesh ObjectMesh(const VirtualObject& object, int sphere_slices) {
   Mesh mesh;
   switch (object.kind) {
-    case MeshKind::kSphere: mesh = SphereMesh(static_cast<float>(object.radius), 48, 96); break;
+    case MeshKind::kSphere: mesh = SphereMesh(static_cast<float>(object.radius), sphere_slices / 2, sphere_slices); break;
     case MeshKind::kBox: mesh = BoxMesh(glm::vec3(object.size)); break;
     case MeshKind::kFile: {
       if (object.file.extension() != ".obj") {

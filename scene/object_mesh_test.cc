@@ -45,6 +45,41 @@ TEST(ObjectMeshTest, BuiltinShapesAreClosedOutwardAndTheRightSize) {
   EXPECT_FALSE(IsClosedMesh(box.positions, flipped));
 }
 
+// The renderer's mesh for a builtin sphere: its polygon within 0.1 pixel of the circle at the
+// sphere's nearest depth, not coarser than 48 slices, the full 96 where it reaches the camera.
+TEST(ObjectMeshTest, ShadingSpheresAreAsFineAsTheirSizeInTheImageNeeds) {
+  Scene scene;
+  scene.intrinsics.fx = scene.intrinsics.fy = 800.0;  // the camera at the origin, looking along +z
+  VirtualObject sphere;
+  sphere.radius = 0.5;
+  const auto slices = [&](double depth) {
+    sphere.position = glm::dvec3(0.0, 0.0, depth);
+    const Mesh m = ShadingMesh(sphere, scene);
+    const Mesh full = ObjectMesh(sphere);
+    EXPECT_EQ(full.positions.size(), 49u * 97u);
+    // (n/2 + 1)·(n + 1) vertices for n slices.
+    for (int n = 2; n <= kSphereSlices; n += 2) {
+      if (m.positions.size() == static_cast<size_t>((n / 2 + 1) * (n + 1))) return n;
+    }
+    ADD_FAILURE() << m.positions.size() << " vertices";
+    return 0;
+  };
+  const auto stray_px = [](double depth, int n) { return 800.0 * 0.5 / (depth - 0.5) * (1.0 - std::cos(glm::pi<double>() / n)); };
+  const int middle = slices(5.0);  // 89 pixels in radius
+  EXPECT_LE(stray_px(5.0, middle), 0.1);
+  EXPECT_GT(stray_px(5.0, middle - 2), 0.1);
+  EXPECT_LT(middle, kSphereSlices);
+  EXPECT_GT(middle, 48);
+  EXPECT_EQ(slices(2.0), kSphereSlices);  // 267 pixels: the full mesh's
+  EXPECT_EQ(slices(100.0), 48);         // 4 pixels: the floor
+  EXPECT_EQ(slices(0.3), kSphereSlices);  // around the camera
+  VirtualObject box;
+  box.kind = MeshKind::kBox;
+  box.size = glm::dvec3(1.0);
+  box.position = glm::dvec3(0.0, 0.0, 100.0);
+  EXPECT_EQ(ShadingMesh(box, scene).positions.size(), ObjectMesh(box).positions.size());
+}
+
 TEST(ObjectMeshTest, PlacementRotatesThenMoves) {
   VirtualObject box;
   box.kind = MeshKind::kBox;
