@@ -39,6 +39,15 @@ RTCRayHit MakeRay(const glm::vec3& origin, const glm::vec3& dir, float t_near, f
   return r;
 }
 
+// Lane i of a packet: the ray origin + t·dir, t ≥ t_near, valid or not.
+void SetLane(RTCRay16& ray, int* valid, size_t i, bool on, const glm::vec3& origin, const glm::vec3& dir, float t_near) {
+  valid[i] = on ? -1 : 0;
+  ray.org_x[i] = origin.x, ray.org_y[i] = origin.y, ray.org_z[i] = origin.z;
+  ray.dir_x[i] = dir.x, ray.dir_y[i] = dir.y, ray.dir_z[i] = dir.z;
+  ray.tnear[i] = t_near, ray.tfar[i] = 1e30f, ray.time[i] = 0.0f;
+  ray.mask[i] = 0xFFFFFFFFu, ray.id[i] = 0, ray.flags[i] = 0;
+}
+
 }  // namespace
 
 RayCaster::RayCaster(const SceneModel& model) : model_(model), embree_(std::make_unique<Embree>()) {
@@ -118,12 +127,7 @@ void RayCaster::IntersectFrom(const glm::vec3& origin, const glm::vec3* dirs, si
   for (size_t begin = 0; begin < count; begin += 16) {
     const size_t n = std::min<size_t>(16, count - begin);
     for (size_t i = 0; i < 16; ++i) {
-      const glm::vec3& d = dirs[begin + std::min(i, n - 1)];
-      valid[i] = i < n ? -1 : 0;
-      packet.ray.org_x[i] = origin.x, packet.ray.org_y[i] = origin.y, packet.ray.org_z[i] = origin.z;
-      packet.ray.dir_x[i] = d.x, packet.ray.dir_y[i] = d.y, packet.ray.dir_z[i] = d.z;
-      packet.ray.tnear[i] = t_near, packet.ray.tfar[i] = 1e30f, packet.ray.time[i] = 0.0f;
-      packet.ray.mask[i] = 0xFFFFFFFFu, packet.ray.id[i] = 0, packet.ray.flags[i] = 0;
+      SetLane(packet.ray, valid, i, i < n, origin, dirs[begin + std::min(i, n - 1)], t_near);
       packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID, packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
     }
     rtcIntersect16(valid, embree_->scene, &context, &packet);
@@ -174,14 +178,7 @@ void RayCaster::OccludedAlong(const glm::vec3* origins, size_t count, const glm:
   alignas(64) int valid[16];
   for (size_t begin = 0; begin < count; begin += 16) {
     const size_t n = std::min<size_t>(16, count - begin);
-    for (size_t i = 0; i < 16; ++i) {
-      const glm::vec3& o = origins[begin + std::min(i, n - 1)];
-      valid[i] = i < n ? -1 : 0;
-      packet.org_x[i] = o.x, packet.org_y[i] = o.y, packet.org_z[i] = o.z;
-      packet.dir_x[i] = dir.x, packet.dir_y[i] = dir.y, packet.dir_z[i] = dir.z;
-      packet.tnear[i] = t_near, packet.tfar[i] = 1e30f, packet.time[i] = 0.0f;
-      packet.mask[i] = 0xFFFFFFFFu, packet.id[i] = 0, packet.flags[i] = 0;
-    }
+    for (size_t i = 0; i < 16; ++i) SetLane(packet, valid, i, i < n, origins[begin + std::min(i, n - 1)], dir, t_near);
     rtcOccluded16(valid, embree_->scene, &context, &packet);
     for (size_t i = 0; i < n; ++i) occluded[begin + i] = packet.tfar[i] < 0.0f ? 1 : 0;
   }

@@ -229,7 +229,8 @@ void RunReplay(const ReplayOptions& o) {
   const int w = renderer.width(), h = renderer.height();
 
   std::vector<FrameFidelity> fidelity;
-  double worst = -1.0;
+  double worst = -1.0, worst_exposure = 1.0;
+  std::vector<float> worst_truth, worst_composite;
   std::vector<float> composite, linear;
   std::vector<double> render_ms;
   const capture::Encoder to_screen(scene.response);
@@ -278,9 +279,9 @@ void RunReplay(const ReplayOptions& o) {
       const render::CompositeFidelity f = render::CompareComposite(composite, linear, truth->with, truth->without, truth->mask);
       fidelity.push_back({frame.index, f});
       const double score = std::max(f.object_error, f.shadow_error);
-      if (score > worst) {
+      if (score > worst) {  // its strip is written once, after the last frame
         worst = score;
-        render::WriteCompositeStrip(dir / "worst_vs_truth.png", w, h, truth->with, composite, frame.exposure, scene.response);
+        worst_truth = truth->with, worst_composite = composite, worst_exposure = frame.exposure;
       }
     }
     if (window) {
@@ -346,6 +347,7 @@ void RunReplay(const ReplayOptions& o) {
                     100 * worst_objects->f.object_error, worst_objects->frame));
     say(fmt::format("  their shadows  {:5.1f}% (worst {:.1f}% at frame {})", 100 * shadows,
                     100 * worst_shadows->f.shadow_error, worst_shadows->frame));
+    render::WriteCompositeStrip(dir / "worst_vs_truth.png", w, h, worst_truth, worst_composite, worst_exposure, scene.response);
     WriteFileAtomically(dir / "fidelity.csv", FidelityCsv(fidelity));
     PlotFidelity(fidelity, scene.name, dir / "fidelity.png");
   }
