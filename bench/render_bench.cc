@@ -1,6 +1,6 @@
 // Rendering the bundled courtyard (960×540, two objects) with software GL (llvmpipe) on this
-// machine: the compositor alone (shadow map, background, phantom, objects, 4× MSAA, resolve and
-// read back) and a whole frame of the replay after decoding (linearise, relight the env map,
+// machine: the compositor alone (shadow map, phantom, objects, 4× MSAA, resolve, read back and
+// blend) and a whole frame of the replay after decoding (linearise, relight the env map,
 // update the volume, the objects' shadows on real surfaces, composite). Bars: rendering alone
 // ≥ 60 fps; the replay end to end ≥ 30 fps.
 #include <benchmark/benchmark.h>
