@@ -101,33 +101,33 @@ void SkyVisibility(const scene::RayCaster& caster, const RayOptions& options, co
 namespace {
 
 // The points of `indices` (or all `count` when null) facing `sun_dir`, block by block on both
-// cores, their shadow rays traced together as packets: lit(k, i, cos_sun) for those it reaches,
-// unlit(k, i) for the others.
+// cores, their shadow rays traced together as packets: lit(i, cos_sun) for those it reaches,
+// unlit(i) for the others.
 template <typename Lit, typename Unlit>
 void ForSunRays(const scene::RayCaster& caster, const glm::vec3* points, const glm::vec3* normals, const uint32_t* indices,
                 size_t count, const glm::vec3& sun_dir, float offset_m, Lit lit, Unlit unlit) {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 2048), [&](const tbb::blocked_range<size_t>& range) {
     thread_local std::vector<glm::vec3> origins;
-    thread_local std::vector<size_t> facing;
+    thread_local std::vector<size_t> facing;  // point indices
     thread_local std::vector<uint8_t> occluded;
     origins.clear(), facing.clear();
     for (size_t k = range.begin(); k != range.end(); ++k) {
       const size_t i = indices != nullptr ? indices[k] : k;
       if (glm::dot(normals[i], sun_dir) > 0.0f) {
         origins.push_back(points[i] + offset_m * normals[i]);
-        facing.push_back(k);
+        facing.push_back(i);
       } else {
-        unlit(k, i);
+        unlit(i);
       }
     }
     occluded.resize(origins.size());
     caster.OccludedAlong(origins.data(), origins.size(), sun_dir, 0.0f, occluded.data());
     for (size_t j = 0; j < facing.size(); ++j) {
-      const size_t k = facing[j], i = indices != nullptr ? indices[k] : k;
+      const size_t i = facing[j];
       if (occluded[j]) {
-        unlit(k, i);
+        unlit(i);
       } else {
-        lit(k, i, glm::dot(normals[i], sun_dir));
+        lit(i, glm::dot(normals[i], sun_dir));
       }
     }
   });
@@ -138,8 +138,8 @@ void ForSunRays(const scene::RayCaster& caster, const glm::vec3* points, const g
 void SunVisibility(const scene::RayCaster& caster, const glm::vec3* points, const glm::vec3* normals, size_t count,
                    const glm::vec3& sun_dir, float offset_m, uint8_t* visible) {
   ForSunRays(
-      caster, points, normals, nullptr, count, sun_dir, offset_m, [&](size_t, size_t i, float) { visible[i] = 1; },
-      [&](size_t, size_t i) { visible[i] = 0; });
+      caster, points, normals, nullptr, count, sun_dir, offset_m, [&](size_t i, float) { visible[i] = 1; },
+      [&](size_t i) { visible[i] = 0; });
 }
 
 void DirectSun(const scene::RayCaster& caster, const glm::vec3* points, const glm::vec3* normals,
@@ -154,11 +154,11 @@ void DirectSun(const scene::RayCaster& caster, const glm::vec3* points, const gl
   }
   ForSunRays(
       caster, points, normals, indices.data(), indices.size(), sun_dir, offset_m,
-      [&](size_t, size_t i, float cos_sun) {
+      [&](size_t i, float cos_sun) {
         direct[i] = cos_sun;
         if (visible != nullptr) visible[i] = 1;
       },
-      [&](size_t, size_t i) {
+      [&](size_t i) {
         direct[i] = 0.0f;
         if (visible != nullptr) visible[i] = 0;
       });

@@ -48,6 +48,19 @@ void SetLane(RTCRay16& ray, int* valid, size_t i, bool on, const glm::vec3& orig
   ray.mask[i] = 0xFFFFFFFFu, ray.id[i] = 0, ray.flags[i] = 0;
 }
 
+// A hit as RayHit: the model's triangle and surface, the normal turned toward the origin.
+RayHit HitOf(const SceneModel& model, const std::vector<uint32_t>& triangle_of_primitive, uint32_t prim, float t,
+             const glm::vec3& ng, const glm::vec3& dir) {
+  RayHit hit;
+  hit.t = t;
+  hit.triangle = triangle_of_primitive[prim];
+  hit.surface = model.triangles[hit.triangle].surface;
+  const glm::vec3 n = glm::normalize(ng);
+  hit.back_face = glm::dot(n, dir) > 0.0f;
+  hit.normal = hit.back_face ? -n : n;
+  return hit;
+}
+
 }  // namespace
 
 RayCaster::RayCaster(const SceneModel& model) : model_(model), embree_(std::make_unique<Embree>()) {
@@ -91,23 +104,6 @@ RayCaster::RayCaster(const SceneModel& model) : model_(model), embree_(std::make
 }
 
 RayCaster::~RayCaster() = default;
-
-namespace {
-
-// A hit as RayHit: the model's triangle and surface, the normal turned toward the origin.
-RayHit HitOf(const SceneModel& model, const std::vector<uint32_t>& triangle_of_primitive, uint32_t prim, float t,
-             const glm::vec3& ng, const glm::vec3& dir) {
-  RayHit hit;
-  hit.t = t;
-  hit.triangle = triangle_of_primitive[prim];
-  hit.surface = model.triangles[hit.triangle].surface;
-  const glm::vec3 n = glm::normalize(ng);
-  hit.back_face = glm::dot(n, dir) > 0.0f;
-  hit.normal = hit.back_face ? -n : n;
-  return hit;
-}
-
-}  // namespace
 
 RayHit RayCaster::Intersect(const glm::vec3& origin, const glm::vec3& dir, float t_near, float t_far) const {
   RTCIntersectContext context;
