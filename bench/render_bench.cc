@@ -9,7 +9,7 @@
 
 #include "bake/bake.h"
 #include "base/log.h"
-#include "estimation/recording_estimator.h"
+#include "estimation/frame_estimator.h"
 #include "render/compositor.h"
 #include "render/frame_renderer.h"
 #include "render/gl_context.h"

@@ -6,13 +6,12 @@
 // interpolation of the coefficients. The sun is not in it: the renderer draws the sun as a
 // directional light with shadows, and keeping it out of the SH is what keeps SH9 accurate.
 //
-// Layout of coefficients() (what the renderer uploads): probe-major, then coefficient, then RGB,
+// Layout of coefficients() (what the renderer reads): probe-major, then coefficient, then RGB,
 // float: value [((k·ny + j)·nx + i)·9 + c] for probe (i, j, k) and coefficient c in sh9.h's
-// order. As textures: 9 RGB32F 3D textures of nx × ny × nz texels, texture c holding
-// coefficient c. Probes sit on the volume's corners and between (ProbePosition: min + (max − min)
-// · i/(n − 1)), so a point p samples the textures at u = 0.5/n + (p − min)/(max − min) · (n − 1)/n
-// per axis, and hardware trilinear filtering is then the interpolation Irradiance() does. The irradiance is
-// E(n) = Σ_c coefficient_c · Y_c(n), no further factors.
+// order. Probes sit on the volume's corners and between (ProbePosition: min + (max − min)
+// · i/(n − 1)); Irradiance() interpolates the coefficients trilinearly between the eight probes
+// around a point, clamped into the box (the compositor interpolates them so to each vertex on
+// the CPU and evaluates them with each fragment's normal). The irradiance is E(n) = Σ_c coefficient_c · Y_c(n), no further factors.
 #pragma once
 
 #include <array>

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "bake/bake.h"
-#include "estimation/recording_estimator.h"
+#include "estimation/frame_estimator.h"
 #include "render/compositor.h"
 #include "relight/env_lights.h"
 #include "relight/env_relight.h"

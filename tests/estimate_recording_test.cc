@@ -9,7 +9,9 @@
 #include "bake/bake.h"
 #include "tests/courtyard_fixture.h"
 #include "base/log.h"
-#include "estimation/recording_estimator.h"
+#include "evaluation/lighting_truth.h"
+#include "pipeline/lighting_pipeline.h"
+#include "scene/raycaster.h"
 #include "scene/scene.h"
 
 namespace daylit {
@@ -18,11 +20,13 @@ namespace {
 TEST(EstimateRecordingTest, CourtyardLightingWithin5PercentOfTheTruth) {
   const scene::Scene& scene = testing::Courtyard().scene;
   const bake::SceneBake& baked = testing::Courtyard().bake;
-  const estimation::EstimateRun run = estimation::EstimateRecording(scene, baked, {});
+  const scene::RayCaster caster(scene.model);
+  pipeline::LightingPipeline lighting(scene, baked, caster, {});
+  const pipeline::PipelineRun run = lighting.Run(scene::OpenFrameSource(scene));
   ASSERT_EQ(run.frames.size(), 600u);
   EXPECT_EQ(run.undecodable, 0);
   ASSERT_TRUE(scene.groundtruth.lighting.has_value());
-  const estimation::TruthComparison truth = estimation::CompareWithTruth(run.frames, *scene.groundtruth.lighting);
+  const evaluation::TruthComparison truth = evaluation::CompareWithTruth(run.frames, *scene.groundtruth.lighting);
   EXPECT_EQ(truth.frames, 600);
   for (int c = 0; c < 3; ++c) {
     EXPECT_LE(truth.sun_error[c], 0.05) << "E_sun channel " << c;

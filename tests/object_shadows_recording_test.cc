@@ -14,7 +14,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "base/csv.h"
-#include "estimation/recording_estimator.h"
+#include "estimation/frame_estimator.h"
 #include "relight/env_relight.h"
 #include "scene/hdr_image.h"
 #include "scene/object_mesh.h"

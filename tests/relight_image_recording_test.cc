@@ -12,7 +12,7 @@
 
 #include "bake/bake.h"
 #include "capture/frame_source.h"
-#include "estimation/recording_estimator.h"
+#include "estimation/frame_estimator.h"
 #include "relight/image_relight.h"
 #include "scene/scene.h"
 #include "tests/courtyard_fixture.h"

@@ -9,7 +9,7 @@
 #include <cstdio>
 #include <optional>
 
-#include "render/composite_truth.h"
+#include "evaluation/composite_truth.h"
 #include "render/gl_context.h"
 #include "tests/courtyard_fixture.h"
 
@@ -38,14 +38,14 @@ TEST(RenderRecordingTest, CompositesMatchThePathTracedFramesWithObjects) {
   std::vector<float> out, linear;
   for (size_t position = 0; position < scene.frame_times->frames.size(); ++position) {
     const int index = scene.frame_times->frames[position].index;
-    const std::optional<TruthFrame> truth = ReadTruthFrame(scene, index);
+    const std::optional<evaluation::TruthFrame> truth = evaluation::ReadTruthFrame(scene, index);
     if (!truth) continue;
     const estimation::FrameFit fit = estimation::FitFrame(scene, c.bake, caster, position, {});
     volume.Linearize(fit.frame, &linear);
     for (int way = 0; way < 2; ++way) {
       FrameRenderer& renderer = way == 0 ? volume : lights;
       renderer.Render(fit.frame, fit.fit.light, fit.fit.overcast_share, fit.sun_dir, &out);
-      const CompositeFidelity f = CompareComposite(out, linear, truth->with, truth->without, truth->mask);
+      const evaluation::CompositeFidelity f = evaluation::CompareComposite(out, linear, truth->with, truth->without, truth->mask);
       std::printf("frame %3d, %s: objects %.1f%% over %zu pixels, their shadows %.1f%% over %zu pixels (the video itself "
                   "%.1f%% off the noise-free frame there)\n", index, way == 0 ? "volume  " : "lights:8",
                   100 * f.object_error, f.object_pixels, 100 * f.shadow_error, f.shadow_pixels, 100 * f.frame_shadow_error);

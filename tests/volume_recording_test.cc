@@ -16,7 +16,7 @@
 #include "tests/courtyard_fixture.h"
 #include "bake/sampling.h"
 #include "base/log.h"
-#include "estimation/recording_estimator.h"
+#include "estimation/frame_estimator.h"
 #include "relight/env_relight.h"
 #include "relight/irradiance_volume.h"
 #include "scene/latlong.h"

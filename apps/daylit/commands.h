@@ -2,6 +2,7 @@
 // writes results to stdout or files and throws InputError for bad input (exit code 2).
 #pragma once
 
+#include <atomic>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -23,5 +24,16 @@ void AddLiveCommand(CLI::App& app);
 
 // --lighting volume|lights:N, for the commands that render the objects (render::ParseLighting).
 void AddLightingOption(CLI::App* cmd, std::string* lighting);
+
+// While one lives, Ctrl-C sets flag() instead of ending the process: a run checks it after each
+// frame and ends with complete outputs. One at a time.
+class StopOnInterrupt {
+ public:
+  StopOnInterrupt();
+  ~StopOnInterrupt();
+  StopOnInterrupt(const StopOnInterrupt&) = delete;
+  StopOnInterrupt& operator=(const StopOnInterrupt&) = delete;
+  const std::atomic<bool>* flag() const;
+};
 
 }  // namespace daylit::app

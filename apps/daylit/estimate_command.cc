@@ -1,5 +1,4 @@
-#include <atomic>
-#include <csignal>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -8,23 +7,22 @@
 
 #include "apps/daylit/commands.h"
 #include "bake/bake.h"
-#include "base/atomic_file.h"
 #include "base/log.h"
-#include "estimation/recording_estimator.h"
+#include "evaluation/lighting_truth.h"
+#include "evaluation/run_report.h"
+#include "pipeline/lighting_pipeline.h"
+#include "scene/raycaster.h"
 #include "scene/scene.h"
 
 namespace daylit::app {
 namespace {
-
-std::atomic<bool> g_stop_estimate{false};
-extern "C" void StopEstimate(int) { g_stop_estimate = true; }
 
 struct EstimateCommandOptions {
   std::string recording;
   std::string cache;
   std::string out = "estimates.csv";
   std::string plot;
-  estimation::EstimateOptions estimate;
+  pipeline::LightingPipelineOptions pipeline;
 };
 
 void RunEstimateCommand(const EstimateCommandOptions& o) {
@@ -36,32 +34,23 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, dir, &loaded);
   Log().info("{} the bake: {}", loaded ? "loaded" : "made", dir.string());
   // Ctrl-C ends a live run after the frame at hand; the CSV and plot are still written.
-  estimation::EstimateOptions options = o.estimate;
-  g_stop_estimate = false;
-  options.stop = &g_stop_estimate;
-  std::signal(SIGINT, StopEstimate);
-  const estimation::EstimateRun run = estimation::EstimateRecording(scene, baked, options, std::move(source));
-  std::signal(SIGINT, SIG_DFL);
-  WriteFileAtomically(o.out, estimation::EstimatesCsv(run.frames));
+  pipeline::LightingPipelineOptions options = o.pipeline;
+  const StopOnInterrupt interrupt;
+  options.stop = interrupt.flag();
+  const scene::RayCaster caster(scene.model);
+  pipeline::LightingPipeline lighting(scene, baked, caster, options);
+  const pipeline::PipelineRun run = lighting.Run(std::move(source));
   const size_t n = run.frames.size();
   double moves_ms = 0.0;
   for (const double ms : run.sun_moves_ms) moves_ms += ms;
-  Log().info("{} frames in {:.2f} s ({:.0f} fps end to end); estimation after decoding {:.2f} ms per frame (median), "
-             "plus {} sun moves taking {:.0f} ms in all; wrote {}",
-             n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9), run.median_frame_ms,
-             run.sun_moves_ms.size(), moves_ms, o.out);
-  if (run.undecodable > 0) Log().warn("{} frames could not be decoded", run.undecodable);
   const std::string plot = o.plot.empty() ? std::filesystem::path(o.out).replace_extension(".png").string() : o.plot;
-  std::optional<estimation::TruthComparison> truth;
-  if (scene.groundtruth.lighting) {
-    truth = estimation::CompareWithTruth(run.frames, *scene.groundtruth.lighting);
-    fmt::print("median relative error over {} frames (R, G, B):\n", truth->frames);
-    fmt::print("  E_sun      {:5.1f}% {:5.1f}% {:5.1f}%\n", 100 * truth->sun_error.x, 100 * truth->sun_error.y, 100 * truth->sun_error.z);
-    fmt::print("  E_sky      {:5.1f}% {:5.1f}% {:5.1f}%\n", 100 * truth->sky_error.x, 100 * truth->sky_error.y, 100 * truth->sky_error.z);
-    fmt::print("  sun/sky    {:5.1f}% {:5.1f}% {:5.1f}%\n", 100 * truth->ratio_error.x, 100 * truth->ratio_error.y, 100 * truth->ratio_error.z);
-  }
-  estimation::PlotEstimates(run.frames, truth ? &*truth : nullptr, scene.name, plot);
-  Log().info("wrote {}", plot);
+  evaluation::RunReport report;
+  evaluation::ReportLighting(scene, run.frames, o.out, plot, &report);
+  Log().info("{} frames in {:.2f} s ({:.0f} fps end to end); estimation after decoding {:.2f} ms per frame (median), "
+             "plus {} sun moves taking {:.0f} ms in all; wrote {} and {}",
+             n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9), run.median_estimate_ms,
+             run.sun_moves_ms.size(), moves_ms, o.out, plot);
+  if (run.undecodable > 0) Log().warn("{} frames could not be decoded", run.undecodable);
 }
 
 }  // namespace
@@ -76,9 +65,9 @@ void AddEstimateCommand(CLI::App& app) {
   cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
   cmd->add_option("--out", options->out, "Estimates CSV (default estimates.csv)");
   cmd->add_option("--plot", options->plot, "Plot PNG (default: the CSV's name with .png)");
-  cmd->add_option("--samples", options->estimate.sampler.samples, "Samples per frame (default 8000)")
+  cmd->add_option("--samples", options->pipeline.estimator.sampler.samples, "Samples per frame (default 8000)")
       ->check(CLI::Range(100, 1000000));
-  cmd->add_option("--frames", options->estimate.max_frames, "Stop after this many frames (a live camera runs until Ctrl-C)")
+  cmd->add_option("--frames", options->pipeline.max_frames, "Stop after this many frames (a live camera runs until Ctrl-C)")
       ->check(CLI::PositiveNumber);
   cmd->callback([options] { RunEstimateCommand(*options); });
 }

@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "apps/daylit/commands.h"
+#include "base/check.h"
 #include "base/error.h"
 #include "base/log.h"
 
@@ -39,6 +40,9 @@ int main(int argc, char** argv) {
   } catch (const daylit::InputError& e) {
     daylit::Log().error("{}", e.what());
     return daylit::kInputErrorExitCode;
+  } catch (const daylit::InvariantError& e) {
+    daylit::Log().critical("internal error (a bug in daylit, not your input): {}", e.what());
+    return daylit::kInternalErrorExitCode;
   } catch (const std::exception& e) {
     daylit::Log().critical("internal error: {}", e.what());
     return 1;

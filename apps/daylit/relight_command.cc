@@ -2,8 +2,6 @@
 // linear, times the ratio E_new / E_now of two irradiance maps from the camera's viewpoint; with
 // --objects, the virtual objects drawn under the new light too.
 #include <algorithm>
-#include <atomic>
-#include <csignal>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -13,15 +11,18 @@
 #include <fmt/format.h>
 
 #include "apps/daylit/commands.h"
-#include "apps/daylit/video_output.h"
 #include "bake/bake.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "capture/frame_source.h"
 #include "capture/response.h"
-#include "estimation/recording_estimator.h"
+#include "estimation/frame_estimator.h"
+#include "evaluation/composite_truth.h"
+#include "pipeline/lighting_pipeline.h"
+#include "pipeline/stages.h"
+#include "pipeline/video_output.h"
+#include "relight/new_light.h"
 #include "relight/image_relight.h"
-#include "render/composite_truth.h"
 #include "render/frame_renderer.h"
 #include "render/gl_context.h"
 #include "render/image_relight_gl.h"
@@ -34,9 +35,6 @@ namespace daylit::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::atomic<bool> g_stop_relight{false};
-extern "C" void StopRelight(int) { g_stop_relight = true; }
 
 struct RelightOptions {
   std::string recording;
@@ -54,17 +52,6 @@ struct RelightOptions {
   bool gpu = false;
 };
 
-// The new sun, and the new light if it is fixed (--like-frame).
-struct Target {
-  glm::vec3 sun_dir{0.0f, 0.0f, 1.0f};
-  double elevation_deg = 90.0;
-  int month = 6;                          // for the clear-sky model
-  std::optional<estimation::SunSky> light;  // --like-frame: that frame's estimate
-  double overcast_share = 0.0;
-  std::optional<glm::dvec3> e_sun, e_sky;   // --e-sun, --e-sky
-  std::string what;                       // for the log
-};
-
 glm::dvec3 RgbOption(const std::vector<double>& v, const char* option) {
   if (v.size() != 3) ThrowInputError("{}: give R,G,B ({} values given)", option, v.size());
   for (const double x : v) {
@@ -73,35 +60,21 @@ glm::dvec3 RgbOption(const std::vector<double>& v, const char* option) {
   return {v[0], v[1], v[2]};
 }
 
-// The light a frame is relit to, from its own (`now`, the estimate) and the options.
-estimation::SunSky NewLight(const RelightOptions& o, const Target& target, const estimation::SunSky& now,
-                            double now_elevation_deg) {
-  estimation::SunSky light = target.light ? *target.light : now;
-  if (o.clear_sky) {
-    const glm::dvec2 f = relight::ClearSkyFactors(now_elevation_deg, target.elevation_deg, target.month);
-    light.sun_rgb *= f.x, light.sky_rgb *= f.y;
-  }
-  if (target.e_sun) light.sun_rgb = *target.e_sun;
-  if (target.e_sky) light.sky_rgb = *target.e_sky;
-  if (target.sun_dir.z <= 0.0f) light.sun_rgb = glm::dvec3(0.0);
-  return light;
-}
-
 // The relit frame's comparison with a real one (--like-frame), printed; the strip beside `out`.
 void CompareWithRealFrame(const scene::Scene& scene, const bake::SceneBake& baked, const relight::ImageRelighter& relighter,
-                          const Target& target, const estimation::FrameFit& original, const std::vector<float>& relit,
+                          const relight::RelightTarget& target, const estimation::FrameFit& original, const std::vector<float>& relit,
                           const estimation::FrameFit& real, const fs::path& out) {
   const capture::Linearizer linearizer(scene.response);
   std::vector<float> before, after;
   capture::LinearRadiance(original.frame, linearizer, &before);
   capture::LinearRadiance(real.frame, linearizer, &after);
-  const relight::SceneLight light{target.sun_dir, relight::SplitLight(*target.light, target.overcast_share)};
+  const relight::SceneLight light{target.sun_dir_in_scene, relight::SplitLight(*target.light, target.overcast_share)};
   const double error = relight::DiffuseError(baked.camera, relit.data(), after.data());
   const std::vector<uint8_t> relit_layout = relight::ShadowLayout(baked.camera, relighter.terms().next, light, relit.data());
   const std::vector<uint8_t> real_layout = relight::ShadowLayout(baked.camera, relighter.terms().next, light, after.data());
   fmt::print("relit frame {} against frame {}: diffuse pixels {:.1f}% mean relative error; shadow layout IoU {:.3f}\n",
              original.row.frame, real.row.frame, 100 * error, relight::ShadowIoU(relit_layout, real_layout));
-  if (const std::optional<render::TruthFrame> truth = render::ReadTruthFrame(scene, real.row.frame)) {
+  if (const std::optional<evaluation::TruthFrame> truth = evaluation::ReadTruthFrame(scene, real.row.frame)) {
     fmt::print("  against the path tracer's noise-free frame {}: {:.1f}% (the real frame itself: {:.1f}%)\n",
                real.row.frame, 100 * relight::DiffuseError(baked.camera, relit.data(), truth->without.data()),
                100 * relight::DiffuseError(baked.camera, after.data(), truth->without.data()));
@@ -124,13 +97,14 @@ void RunRelight(const RelightOptions& o) {
     if (ext != ".png" && ext != ".exr") ThrowInputError("--out: {} must end in .png or .exr", o.out);
     if (!o.frames.empty()) ThrowInputError("--frames: not with --frame");
   } else {
-    CheckVideoName(out);
+    pipeline::CheckVideoName(out);
   }
   const int given = (o.at.empty() ? 0 : 1) + (o.azimuth || o.elevation ? 1 : 0) + (o.like_frame ? 1 : 0);
   if (given != 1) ThrowInputError("give the new sun one way: --at, --sun-azimuth with --sun-elevation, or --like-frame");
   if (o.azimuth.has_value() != o.elevation.has_value()) ThrowInputError("--sun-azimuth and --sun-elevation go together");
   if (o.sky != "keep" && o.sky != "follow") ThrowInputError("--sky: '{}' is not keep or follow", o.sky);
-  Target target;
+  relight::RelightTarget target;
+  target.clear_sky = o.clear_sky;
   if (!o.e_sun.empty()) target.e_sun = RgbOption(o.e_sun, "--e-sun");
   if (!o.e_sky.empty()) target.e_sky = RgbOption(o.e_sky, "--e-sky");
   const scene::Scene scene = scene::LoadScene(o.recording);
@@ -162,15 +136,15 @@ void RunRelight(const RelightOptions& o) {
     const UtcTime utc = ParseUtcTime(o.at, "--at");
     const scene::SceneSun at = scene::SunAt(scene, utc);
     const sunmodel::SunPosition& sun = at.position;
-    target.sun_dir = glm::vec3(at.dir);
-    target.elevation_deg = sun.ApparentElevationDeg();
+    target.sun_dir_in_scene = glm::vec3(at.dir);
+    target.sun_elevation_deg = sun.ApparentElevationDeg();
     target.month = utc.month;
-    target.what = fmt::format("the sun at {} ({:.1f}° up, azimuth {:.1f}°)", o.at, target.elevation_deg, sun.azimuth_deg);
+    target.what = fmt::format("the sun at {} ({:.1f}° up, azimuth {:.1f}°)", o.at, target.sun_elevation_deg, sun.azimuth_deg);
   } else if (o.azimuth) {
     if (!std::isfinite(*o.azimuth)) ThrowInputError("--sun-azimuth: {} is not an angle", *o.azimuth);
     if (!(*o.elevation >= -90.0 && *o.elevation <= 90.0)) ThrowInputError("--sun-elevation: {} is outside [-90, 90]", *o.elevation);
-    target.sun_dir = glm::vec3(geo.DirectionInScene(*o.azimuth, 90.0 - *o.elevation));
-    target.elevation_deg = *o.elevation;
+    target.sun_dir_in_scene = glm::vec3(geo.DirectionInScene(*o.azimuth, 90.0 - *o.elevation));
+    target.sun_elevation_deg = *o.elevation;
     target.month = scene.frame_times->frames[position].utc.month;
     target.what = fmt::format("the sun at {:.1f}° up, azimuth {:.1f}°", *o.elevation, *o.azimuth);
   }
@@ -181,7 +155,7 @@ void RunRelight(const RelightOptions& o) {
     gl = render::HeadlessGlContext::Create(&why);
     if (gl == nullptr) ThrowInputError("OpenGL: {}", why);
   }
-  std::optional<VideoOutput> video;
+  std::optional<pipeline::VideoOutput> video;
   if (!single) video.emplace(out, scene);
 
   bool loaded = false;
@@ -191,94 +165,59 @@ void RunRelight(const RelightOptions& o) {
   if (o.like_frame) {
     like = estimation::FitFrame(scene, baked, caster, scene::FramePosition(scene, *o.like_frame, "--like-frame"), {});
     if (!like->fit.IsUsable()) ThrowInputError("--like-frame: frame {} has no estimate ({})", *o.like_frame, like->fit.message);
-    target.sun_dir = like->sun_dir;
-    target.elevation_deg = like->row.sun_elevation_deg;
+    target.sun_dir_in_scene = like->sun_dir;
+    target.sun_elevation_deg = like->row.sun_elevation_deg;
     target.month = like->row.time_utc.month;
     target.light = like->fit.light;
     target.overcast_share = like->fit.overcast_share;
     target.what = fmt::format("the sun and light of frame {} ({:.1f}° up, azimuth {:.1f}°)", *o.like_frame,
-                              target.elevation_deg, like->row.sun_azimuth_deg);
+                              target.sun_elevation_deg, like->row.sun_azimuth_deg);
   }
-  if (target.sun_dir.z <= 0.0f) {
-    Log().warn("{}: the sun is {:.1f}° below the horizon; a sky-only relight (E_sun = 0)", target.what, -target.elevation_deg);
+  if (target.sun_dir_in_scene.z <= 0.0f) {
+    Log().warn("{}: the sun is {:.1f}° below the horizon; a sky-only relight (E_sun = 0)", target.what, -target.sun_elevation_deg);
   }
-  relight::ImageRelightOptions options;
-  options.sky = o.sky == "follow" ? relight::SkyPixels::kFollow : relight::SkyPixels::kKeep;
-  relight::ImageRelighter relighter(scene, baked, caster, options);
-  std::unique_ptr<render::ImageRelightGl> on_gpu;
-  if (o.gpu) on_gpu = std::make_unique<render::ImageRelightGl>(relighter.width(), relighter.height());
+  pipeline::RelightStageOptions options;
+  options.relight.sky = o.sky == "follow" ? relight::SkyPixels::kFollow : relight::SkyPixels::kKeep;
+  options.gpu = o.gpu;
   std::unique_ptr<render::FrameRenderer> renderer;
   if (o.objects) renderer = std::make_unique<render::FrameRenderer>(scene, baked, caster);
+  pipeline::RelightStage stage(scene, baked, caster, target, options, renderer.get());
   Log().info("relighting to {}{}", target.what, o.gpu ? ", on the GPU path" : "");
-
-  const capture::Linearizer linearizer(scene.response);
-  size_t clamped = 0, model_pixels = 0;
-  // One frame: linearised, relit, the objects drawn under the new light.
-  const auto relight_frame = [&](const capture::Frame& frame, const estimation::SunSky& now_light, double now_overcast,
-                                 const glm::vec3& now_sun, double now_elevation_deg, std::vector<float>* image) {
-    capture::LinearRadiance(frame, linearizer, image);
-    const estimation::SunSky next_light = NewLight(o, target, now_light, now_elevation_deg);
-    const double next_overcast = target.light ? target.overcast_share : now_overcast;
-    if (relighter.SetSuns(now_sun, target.sun_dir) && on_gpu) on_gpu->SetTerms(relighter.terms());
-    const relight::LightParts now = relight::SplitLight(now_light, now_overcast);
-    const relight::LightParts next = relight::SplitLight(next_light, next_overcast);
-    const relight::RelightStats stats =
-        on_gpu ? on_gpu->Apply(relighter.terms(), now, next, image->data()) : relighter.Apply(now, next, image->data());
-    clamped += stats.clamped, model_pixels += stats.model_pixels;
-    if (renderer) renderer->RenderLinear(next_light, next_overcast, target.sun_dir, image->data());
-  };
-
   if (single) {
     const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, position, {});
     if (!fit.fit.IsUsable()) ThrowInputError("frame {}: no estimate ({}); it cannot be relit", *o.frame, fit.fit.message);
     std::vector<float> image;
-    relight_frame(fit.frame, fit.fit.light, fit.fit.overcast_share, fit.sun_dir, fit.row.sun_elevation_deg, &image);
-    const int w = relighter.width(), h = relighter.height();
+    stage.Relight(fit.frame, fit.fit.light, fit.fit.overcast_share, fit.sun_dir, fit.row.sun_elevation_deg, &image);
+    const int w = stage.relighter().width(), h = stage.relighter().height();
     if (out.extension() == ".exr") {
       scene::WriteRgbExr(out, w, h, image.data());
     } else {
       report::WritePng(out, {capture::EncodeToBgr8(image.data(), w, h, fit.frame.exposure, &scene.response)});
     }
     Log().info("frame {}: wrote {}", *o.frame, o.out);
-    if (like) CompareWithRealFrame(scene, baked, relighter, target, fit, image, *like, out);
+    if (like) CompareWithRealFrame(scene, baked, stage.relighter(), target, fit, image, *like, out);
   } else {
-    estimation::EstimateOptions estimate;
-    estimate.progress_label = "relight";
-    g_stop_relight = false;
-    estimate.stop = &g_stop_relight;
-    if (last_position) estimate.max_frames = static_cast<int>(*last_position) + 1;
-    int written = 0, unrelit = 0;
-    estimate.on_frame = [&](const estimation::FrameEstimate& row, const capture::Frame& frame, const glm::vec3& sun_dir,
-                            double overcast_share) {
-      if (first && row.frame < *first) return;
-      ++written;
-      capture::AsyncVideoWriter& writer = video->writer();
-      if (frame.rgb.empty()) {  // could not be read: the frame before again
-        writer.Write({}, 1.0);
-        return;
-      }
-      std::vector<float> image = writer.TakeBuffer();
-      if (!row.HasEstimate()) {  // no usable fit yet: written as it is
-        ++unrelit;
-        capture::LinearRadiance(frame, linearizer, &image);
-      } else {
-        relight_frame(frame, row.light, overcast_share, sun_dir, row.sun_elevation_deg, &image);
-      }
-      writer.Write(std::move(image), frame.exposure);
-    };
-    std::signal(SIGINT, StopRelight);
-    const estimation::EstimateRun run = estimation::EstimateRecording(scene, baked, estimate, scene::OpenFrameSource(scene));
-    std::signal(SIGINT, SIG_DFL);
+    pipeline::LightingPipelineOptions run_options;
+    run_options.progress_label = "relight";
+    const StopOnInterrupt interrupt;
+    run_options.stop = interrupt.flag();
+    if (last_position) run_options.max_frames = static_cast<int>(*last_position) + 1;
+    run_options.first_output_frame = first;
+    pipeline::LightingPipeline lighting(scene, baked, caster, run_options);
+    lighting.SetStage(&stage);
+    lighting.SetVideo(&video->writer());
+    const pipeline::PipelineRun run = lighting.Run(scene::OpenFrameSource(scene));
     video->Commit();
-    fmt::print("{}: {} frames relit to {} in {:.1f} s ({:.1f} fps)\n", scene.name, written - unrelit, target.what,
+    fmt::print("{}: {} frames relit to {} in {:.1f} s ({:.1f} fps)\n", scene.name, stage.relit(), target.what,
                run.seconds, static_cast<double>(run.frames.size()) / std::max(run.seconds, 1e-9));
-    if (unrelit > 0) Log().warn("{} frames had no estimate yet (no usable fit) and are written as they are", unrelit);
+    if (stage.unrelit() > 0) {
+      Log().warn("{} frames had no estimate yet (no usable fit) and are written as they are", stage.unrelit());
+    }
     Log().info("wrote {}", o.out);
   }
-  if (clamped > 0) {
+  if (stage.ClampedShare() > 0.0) {
     Log().info("{:.2f}% of the model's pixels were in deep shadow (E_now below 2% of what open level ground receives); "
-               "their ratio is E_new over that floor",
-               100.0 * static_cast<double>(clamped) / static_cast<double>(std::max<size_t>(model_pixels, 1)));
+               "their ratio is E_new over that floor", 100.0 * stage.ClampedShare());
   }
 }
 

@@ -10,7 +10,7 @@
 #include "bake/bake.h"
 #include "base/error.h"
 #include "base/log.h"
-#include "estimation/recording_estimator.h"
+#include "estimation/frame_estimator.h"
 #include "relight/env_relight.h"
 #include "scene/scene.h"
 

@@ -11,8 +11,8 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "capture/response.h"
-#include "estimation/recording_estimator.h"
-#include "render/composite_truth.h"
+#include "estimation/frame_estimator.h"
+#include "evaluation/composite_truth.h"
 #include "render/frame_renderer.h"
 #include "render/gl_context.h"
 #include "report/plot.h"
@@ -64,15 +64,15 @@ void RunRender(const RenderOptions& o) {
              fit.fit.light.sun_rgb.x, fit.fit.light.sun_rgb.y, fit.fit.light.sun_rgb.z, fit.fit.light.sky_rgb.x,
              fit.fit.light.sky_rgb.y, fit.fit.light.sky_rgb.z, o.out);
   // Against the path tracer's frame with the objects, when the recording has it.
-  const std::optional<render::TruthFrame> truth = render::ReadTruthFrame(scene, o.frame);
+  const std::optional<evaluation::TruthFrame> truth = evaluation::ReadTruthFrame(scene, o.frame);
   if (!truth) return;
   std::vector<float> linear;
   renderer.Linearize(fit.frame, &linear);
-  const render::CompositeFidelity f = render::CompareComposite(composite, linear, truth->with, truth->without, truth->mask);
+  const evaluation::CompositeFidelity f = evaluation::CompareComposite(composite, linear, truth->with, truth->without, truth->mask);
   fs::path strip = out;
   strip.replace_extension();
   strip += "_vs_truth.png";
-  render::WriteCompositeStrip(strip, w, h, truth->with, composite, fit.frame.exposure, scene.response);
+  evaluation::WriteCompositeStrip(strip, w, h, truth->with, composite, fit.frame.exposure, scene.response);
   fmt::print("against {}: objects {:.1f}% over {} pixels, their shadows {:.1f}% over {} pixels (the frame itself "
              "{:.1f}% off the truth there)\n",
              truth->with_file.string(), 100 * f.object_error, f.object_pixels, 100 * f.shadow_error, f.shadow_pixels,

@@ -9,7 +9,7 @@
 #include "capture/async_video_writer.h"
 #include "scene/scene.h"
 
-namespace daylit::app {
+namespace daylit::pipeline {
 
 // Throws InputError unless `out` ends in .mp4 or .mkv.
 void CheckVideoName(const std::filesystem::path& out);
@@ -32,4 +32,4 @@ class VideoOutput {
   bool committed_ = false;
 };
 
-}  // namespace daylit::app
+}  // namespace daylit::pipeline

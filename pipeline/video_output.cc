@@ -1,11 +1,11 @@
-#include "apps/daylit/video_output.h"
+#include "pipeline/video_output.h"
 
 #include <system_error>
 
 #include "base/atomic_file.h"
 #include "base/error.h"
 
-namespace daylit::app {
+namespace daylit::pipeline {
 
 namespace fs = std::filesystem;
 
@@ -41,4 +41,4 @@ void VideoOutput::Commit() {
   committed_ = true;
 }
 
-}  // namespace daylit::app
+}  // namespace daylit::pipeline

@@ -14,7 +14,7 @@
 #include "capture/response.h"
 #include "scene/scene.h"
 
-namespace daylit::render {
+namespace daylit::evaluation {
 
 // The path tracer's frame `index` (groundtruth/ of recording-format.md): with the objects and
 // without them (linear RGB, row-major from the top) and the objects' mask (8-bit).
@@ -46,4 +46,4 @@ CompositeFidelity CompareComposite(const std::vector<float>& composite, const st
 void WriteCompositeStrip(const std::filesystem::path& png, int width, int height, const std::vector<float>& truth,
                          const std::vector<float>& composite, double exposure, const capture::CameraResponse& response);
 
-}  // namespace daylit::render
+}  // namespace daylit::evaluation

@@ -1,4 +1,4 @@
-#include "render/composite_truth.h"
+#include "evaluation/composite_truth.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include "report/plot.h"
 #include "scene/hdr_image.h"
 
-namespace daylit::render {
+namespace daylit::evaluation {
 
 std::optional<TruthFrame> ReadTruthFrame(const scene::Scene& scene, int index) {
   namespace fs = std::filesystem;
@@ -73,4 +73,4 @@ void WriteCompositeStrip(const std::filesystem::path& png, int width, int height
   report::WritePng(png, {strip});
 }
 
-}  // namespace daylit::render
+}  // namespace daylit::evaluation

@@ -1,0 +1,91 @@
+#include "capture/read_ahead.h"
+
+#include <tbb/concurrent_queue.h>
+
+#include <atomic>
+#include <exception>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "base/check.h"
+
+namespace daylit::capture {
+namespace {
+
+struct DecodedFrame {
+  FrameStatus status = FrameStatus::kEnd;
+  Frame frame;
+  std::exception_ptr error;  // a failure that is not the frame's own: ends the stream
+};
+
+class ReadAheadSource final : public FrameSource {
+ public:
+  ReadAheadSource(std::unique_ptr<FrameSource> source, int depth) : source_(std::move(source)) {
+    DAYLIT_CHECK(source_ != nullptr);
+    DAYLIT_CHECK(depth >= 1 && depth <= 64, "depth {}", depth);
+    queue_.set_capacity(depth);
+    thread_ = std::thread([this] { Run(); });
+  }
+  ~ReadAheadSource() override {
+    // Wakes a reader blocked on a full queue (abort) and empties the queue so that one still
+    // decoding pushes without waiting; either way it then sees stop_ and ends.
+    stop_ = true;
+    queue_.abort();
+    DecodedFrame dropped;
+    while (queue_.try_pop(dropped)) {}
+    thread_.join();
+  }
+
+  FrameStatus Next(Frame* frame) override {
+    if (ended_) return FrameStatus::kEnd;
+    DecodedFrame next;
+    queue_.pop(next);
+    if (next.error) {
+      ended_ = true;
+      std::rethrow_exception(next.error);
+    }
+    if (next.status == FrameStatus::kEnd) ended_ = true;
+    if (next.status == FrameStatus::kFrame) ++stats_.delivered;
+    if (next.status == FrameStatus::kUndecodable) ++stats_.undecodable;
+    *frame = std::move(next.frame);
+    return next.status;
+  }
+  void Seek(int index) override { DAYLIT_CHECK(false, "Seek({}) on a read-ahead source", index); }
+  std::string Describe() const override { return fmt::format("{}, read ahead", source_->Describe()); }
+  bool live() const override { return source_->live(); }
+
+ private:
+  void Run() {
+    while (!stop_) {
+      DecodedFrame frame;
+      try {
+        frame.status = source_->Next(&frame.frame);
+        if (frame.status == FrameStatus::kWaiting) continue;
+      } catch (...) {
+        frame.error = std::current_exception();
+      }
+      const bool last = static_cast<bool>(frame.error) || frame.status == FrameStatus::kEnd;
+      try {
+        queue_.push(std::move(frame));  // waits while the caller is `depth` frames behind
+      } catch (const tbb::user_abort&) {
+        return;
+      }
+      if (last) return;
+    }
+  }
+
+  std::unique_ptr<FrameSource> source_;
+  tbb::concurrent_bounded_queue<DecodedFrame> queue_;
+  std::atomic<bool> stop_{false};
+  bool ended_ = false;
+  std::thread thread_;  // last: starts once the rest is built
+};
+
+}  // namespace
+
+std::unique_ptr<FrameSource> ReadAhead(std::unique_ptr<FrameSource> source, int depth) {
+  return std::make_unique<ReadAheadSource>(std::move(source), depth);
+}
+
+}  // namespace daylit::capture

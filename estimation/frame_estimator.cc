@@ -1,0 +1,120 @@
+#include "estimation/frame_estimator.h"
+
+#include <fmt/format.h>
+
+#include "base/check.h"
+#include "base/error.h"
+
+namespace daylit::estimation {
+namespace {
+
+glm::vec3 CapturePoint(const scene::Scene& scene) {
+  return scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f);
+}
+
+}  // namespace
+
+FrameEstimator::FrameEstimator(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                               const FrameEstimatorOptions& options)
+    : bake_(bake),
+      options_(options),
+      sampler_(bake, CapturePoint(scene), caster, options.sampler),
+      filter_(options.filter),
+      linearizer_(scene.response) {}
+
+FrameEstimate FrameEstimator::Row(const capture::Frame& frame, const scene::TrackedSun& sun) const {
+  FrameEstimate row;
+  row.frame = frame.index;
+  row.time_utc = frame.utc;
+  row.sun_elevation_deg = sun.position.ApparentElevationDeg();
+  row.sun_azimuth_deg = sun.position.azimuth_deg;
+  return row;
+}
+
+double FrameEstimator::SecondsSinceFirst(const UtcTime& utc) {
+  if (!first_utc_) first_utc_ = utc;
+  return utc.SecondsSince(*first_utc_);
+}
+
+FrameLight FrameEstimator::Estimate(const capture::Frame& frame, const scene::TrackedSun& sun) {
+  DAYLIT_CHECK(frame.rgb.cols == bake_.camera.width && frame.rgb.rows == bake_.camera.height,
+               "frame {} is {}x{}, the camera {}x{}", frame.index, frame.rgb.cols, frame.rgb.rows, bake_.camera.width,
+               bake_.camera.height);
+  FrameLight out;
+  out.row = Row(frame, sun);
+  const double t_s = SecondsSinceFirst(frame.utc);
+  out.sun_moved = sampler_.SetSun(sun.dir_in_scene);
+  const std::vector<Sample> samples = sampler_.Draw(frame.rgb, frame.exposure, frame.linear ? nullptr : &linearizer_);
+  out.fit = FitSunSky(options_.fit, samples);
+  const FilteredLight filtered =
+      filter_.Update(t_s, out.fit.IsUsable() ? std::optional<SunSky>(out.fit.light) : std::nullopt, out.fit.confidence);
+  if (out.fit.IsUsable()) overcast_share_ = out.fit.overcast_share;
+  out.overcast_share = overcast_share_;
+  out.row.light = filtered.light;
+  out.row.confidence = filtered.confidence;
+  out.row.samples = static_cast<int>(samples.size());
+  return out;
+}
+
+FrameLight FrameEstimator::Hold(const capture::Frame& frame, const scene::TrackedSun& sun) {
+  FrameLight out;
+  out.row = Row(frame, sun);
+  out.row.decoded = false;
+  const FilteredLight held = filter_.Update(SecondsSinceFirst(frame.utc), std::nullopt, 0.0);
+  out.row.light = held.light;
+  out.row.confidence = held.confidence;
+  out.overcast_share = overcast_share_;
+  out.fit.message = "the frame could not be read";
+  return out;
+}
+
+FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster, size_t position,
+                  const FrameEstimatorOptions& options) {
+  if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
+  const std::vector<capture::FrameTime>& times = scene.frame_times->frames;
+  if (position >= times.size()) {
+    ThrowInputError("{}: frame {} is past the recording's {} frames", scene.file.string(), position, times.size());
+  }
+  std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
+  source->Seek(times[position].index);
+  capture::Frame frame;
+  if (source->Next(&frame) != capture::FrameStatus::kFrame) {
+    ThrowInputError("{}: frame {} cannot be decoded", scene.file.string(), times[position].index);
+  }
+  return FitDecodedFrame(scene, bake, caster, std::move(frame), options);
+}
+
+FrameFit FitDecodedFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                         capture::Frame frame, const FrameEstimatorOptions& options) {
+  if (frame.rgb.cols != bake.camera.width || frame.rgb.rows != bake.camera.height) {
+    ThrowInputError("{}: frame {} is {}x{}, not the camera's {}x{}", scene.file.string(), frame.index, frame.rgb.cols,
+                    frame.rgb.rows, bake.camera.width, bake.camera.height);
+  }
+  scene::SunTracker tracker(scene);
+  const scene::TrackedSun& sun = tracker.Update(frame.utc);
+  FrameEstimator estimator(scene, bake, caster, options);
+  const FrameLight light = estimator.Estimate(frame, sun);
+  FrameFit out;
+  out.row = light.row;
+  out.row.light = light.fit.light;  // the fit's own, not the filter's
+  out.row.confidence = light.fit.confidence;
+  out.fit = light.fit;
+  out.sun_dir = sun.dir_in_scene;
+  out.frame = std::move(frame);
+  return out;
+}
+
+std::string EstimatesCsv(const std::vector<FrameEstimate>& frames) {
+  fmt::memory_buffer out;
+  fmt::format_to(std::back_inserter(out), "frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,"
+                                          "sky_g,sky_b,confidence,samples\n");
+  for (const FrameEstimate& f : frames) {
+    fmt::format_to(std::back_inserter(out), "{},{},{:.4f},{:.4f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{}\n",
+                   f.frame, FormatUtcTime(f.time_utc), f.sun_elevation_deg, f.sun_azimuth_deg, f.light.sun_rgb.x,
+                   f.light.sun_rgb.y, f.light.sun_rgb.z, f.light.sky_rgb.x, f.light.sky_rgb.y, f.light.sky_rgb.z,
+                   f.confidence, f.samples);
+  }
+  return fmt::to_string(out);
+}
+
+}  // namespace daylit::estimation

@@ -1,0 +1,95 @@
+// The per-frame estimator of the pipeline (pipeline::LightingPipeline): for one frame and its sun,
+// the sampler's strata (re-cast only when the sun has moved), the robust fit of E_sun and E_sky,
+// and the temporal filter. It keeps that state between frames but no thread, file or clock of its
+// own; the controller owns the loop. Headless: no GL.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "bake/bake.h"
+#include "capture/frame_source.h"
+#include "estimation/sampler.h"
+#include "estimation/sun_sky_fit.h"
+#include "estimation/temporal_filter.h"
+#include "scene/raycaster.h"
+#include "scene/scene.h"
+#include "scene/sun_tracker.h"
+
+namespace daylit::estimation {
+
+struct FrameEstimatorOptions {
+  SamplerOptions sampler;
+  SunSkyFitOptions fit;
+  TemporalFilterOptions filter;
+};
+
+// One row of estimates.csv.
+struct FrameEstimate {
+  int frame = 0;
+  UtcTime time_utc;
+  double sun_elevation_deg = 0.0;  // apparent
+  double sun_azimuth_deg = 0.0;    // east of north
+  SunSky light;                    // filtered E_sun, E_sky (radiance units, exposure divided out)
+  double confidence = 0.0;
+  int samples = 0;
+  bool decoded = true;             // false: the frame could not be decoded (the estimate holds)
+
+  // False until the first usable fit: the light is all zero before it.
+  bool HasEstimate() const { return light.sky_rgb.x + light.sky_rgb.y + light.sky_rgb.z > 0.0; }
+};
+
+// What the estimator made of one frame.
+struct FrameLight {
+  FrameEstimate row;
+  // E_overcast / E_sky of the last usable fit, held like the light (0 before the first).
+  double overcast_share = 0.0;
+  SunSkyFitSummary fit;     // this frame's own fit (status kTooFewSamples for a held frame)
+  bool sun_moved = false;   // the strata and transfer terms were redone for this frame
+};
+
+class FrameEstimator {
+ public:
+  // `caster` is over the scene's model; the estimator keeps references to `bake` and `caster`.
+  FrameEstimator(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                 const FrameEstimatorOptions& options);
+
+  // `frame` has pixels of the bake's camera size (a broken caller otherwise: CHECK); `sun` is
+  // the frame's (scene::SunTracker).
+  FrameLight Estimate(const capture::Frame& frame, const scene::TrackedSun& sun);
+  // A frame that could not be read (its index and time only): the filtered estimate holds.
+  FrameLight Hold(const capture::Frame& frame, const scene::TrackedSun& sun);
+
+ private:
+  FrameEstimate Row(const capture::Frame& frame, const scene::TrackedSun& sun) const;
+  double SecondsSinceFirst(const UtcTime& utc);
+
+  const bake::SceneBake& bake_;
+  FrameEstimatorOptions options_;
+  Sampler sampler_;
+  TemporalFilter filter_;
+  capture::Linearizer linearizer_;
+  std::optional<UtcTime> first_utc_;
+  double overcast_share_ = 0.0;
+};
+
+// The unfiltered fit of one frame (its position in frames.csv), as the estimator makes it:
+// decodes the recording up to it. Throws InputError if the position is out of range or the frame
+// cannot be decoded. `caster`: the scene's model.
+struct FrameFit {
+  FrameEstimate row;        // light and confidence: the fit's own
+  SunSkyFitSummary fit;
+  glm::vec3 sun_dir{0.0f};  // unit, scene coordinates
+  capture::Frame frame;     // the frame it was fitted to
+};
+FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster, size_t position,
+                  const FrameEstimatorOptions& options);
+// The same for a frame already read.
+FrameFit FitDecodedFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                         capture::Frame frame, const FrameEstimatorOptions& options);
+
+// The stable CSV: frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,sky_g,
+// sky_b,confidence,samples.
+std::string EstimatesCsv(const std::vector<FrameEstimate>& frames);
+
+}  // namespace daylit::estimation

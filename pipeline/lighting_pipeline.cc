@@ -1,0 +1,116 @@
+#include "pipeline/lighting_pipeline.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "base/check.h"
+#include "base/log.h"
+#include "base/progress.h"
+#include "base/statistics.h"
+#include "capture/read_ahead.h"
+
+namespace daylit::pipeline {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MillisecondsSince(Clock::time_point t0) { return 1e3 * std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+}  // namespace
+
+std::string LightingPipelineOptions::Check() const {
+  if (max_frames && *max_frames < 1) return fmt::format("max_frames: {} is not a number of frames (≥ 1)", *max_frames);
+  return sun.Check();
+}
+
+LightingPipeline::LightingPipeline(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                                   const LightingPipelineOptions& options)
+    : scene_(scene), bake_(bake), caster_(caster), options_(options) {
+  const std::string why = options.Check();
+  DAYLIT_CHECK(why.empty(), "{}", why);
+}
+
+bool LightingPipeline::StopRequested() const {
+  if (options_.stop != nullptr && options_.stop->load()) return true;
+  return std::any_of(sinks_.begin(), sinks_.end(), [](const FrameSink* sink) { return sink->StopRequested(); });
+}
+
+PipelineRun LightingPipeline::Run(std::unique_ptr<capture::FrameSource> source) {
+  DAYLIT_CHECK(video_ == nullptr || stage_ != nullptr, "a video needs a stage that makes its images");
+  std::unique_ptr<capture::FrameSource> frames = capture::ReadAhead(std::move(source));
+  scene::SunTracker sun_tracker(scene_, options_.sun);
+  estimation::FrameEstimator estimator(scene_, bake_, caster_, options_.estimator);
+  PipelineRun run;
+  // A recording's length is known; a live camera's is max_frames, else until stopped.
+  std::optional<size_t> total;
+  if (scene_.frame_times) total = scene_.frame_times->frames.size();
+  if (options_.max_frames) total = std::min(total.value_or(SIZE_MAX), static_cast<size_t>(*options_.max_frames));
+  std::optional<Progress> progress;
+  if (total) progress.emplace(options_.progress_label, *total);
+  std::vector<double> estimate_ms, stage_ms;
+  const Clock::time_point start = Clock::now();
+  for (size_t i = 0; !total || i < *total; ++i) {
+    if (StopRequested()) break;
+    capture::Frame frame;
+    const capture::FrameStatus status = frames->Next(&frame);
+    if (status == capture::FrameStatus::kEnd) break;
+    const scene::TrackedSun& sun = sun_tracker.Update(frame.utc);
+    bool readable = status == capture::FrameStatus::kFrame;
+    if (readable && (frame.rgb.cols != bake_.camera.width || frame.rgb.rows != bake_.camera.height)) {
+      Log().warn("{}: frame {} is {}x{}, not the camera's {}x{}; skipped", scene_.file.string(), frame.index,
+                 frame.rgb.cols, frame.rgb.rows, bake_.camera.width, bake_.camera.height);
+      readable = false;
+    }
+    const Clock::time_point began = Clock::now();
+    const estimation::FrameLight light = readable ? estimator.Estimate(frame, sun) : estimator.Hold(frame, sun);
+    if (readable) (light.sun_moved ? run.sun_moves_ms : estimate_ms).push_back(MillisecondsSince(began));
+    if (!readable) {
+      ++run.undecodable;
+      frame.rgb.release();
+    }
+    run.frames.push_back(light.row);
+    if (!options_.first_output_frame || frame.index >= *options_.first_output_frame) {
+      const double ms = Deliver(frame, light, sun);
+      if (ms >= 0.0) stage_ms.push_back(ms);
+    }
+    const double fps = static_cast<double>(i + 1) / std::max(std::chrono::duration<double>(Clock::now() - start).count(), 1e-9);
+    if (progress) {
+      progress->Advance();
+      if (readable) progress->SetSuffix(fmt::format("{:.0f} fps", fps));
+    } else if ((i + 1) % 100 == 0) {
+      const estimation::SunSky& e = light.row.light;
+      Log().info("{} frames, {:.0f} fps; E_sun ({:.3g}, {:.3g}, {:.3g}), E_sky ({:.3g}, {:.3g}, {:.3g})", i + 1, fps,
+                 e.sun_rgb.x, e.sun_rgb.y, e.sun_rgb.z, e.sky_rgb.x, e.sky_rgb.y, e.sky_rgb.z);
+    }
+  }
+  run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  run.median_estimate_ms = MedianInPlace(estimate_ms, static_cast<double>(NAN));
+  run.median_stage_ms = MedianInPlace(stage_ms, 0.0);
+  return run;
+}
+
+double LightingPipeline::Deliver(const capture::Frame& frame, const estimation::FrameLight& light,
+                                 const scene::TrackedSun& sun) {
+  const bool readable = !frame.rgb.empty();
+  double ms = -1.0;
+  PipelineFrame out{frame, light, sun};
+  if (stage_ != nullptr && readable) {
+    if (video_ != nullptr) image_ = video_->TakeBuffer();
+    const Clock::time_point t0 = Clock::now();
+    out.image_light = stage_->Process(frame, light, sun, &image_);
+    ms = MillisecondsSince(t0);
+    out.image = &image_;
+  }
+  for (FrameSink* sink : sinks_) sink->Consume(out);
+  if (video_ != nullptr) {
+    // A frame that could not be read shows the last one again, so the video keeps its timing.
+    video_->Write(readable ? std::move(image_) : std::vector<float>{}, frame.exposure);
+    image_.clear();
+  }
+  return ms;
+}
+
+}  // namespace daylit::pipeline

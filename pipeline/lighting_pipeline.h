@@ -1,0 +1,117 @@
+// The pipeline controller (design.md's online pipeline): it owns the frame loop of daylit
+// estimate, replay, live and relight. For each frame of a FrameSource (a recording or a live
+// camera, read ahead on its own thread): the sun (one scene::SunTracker, one sun-moved rule), the
+// per-frame estimate (estimation::FrameEstimator, no thread of its own), an optional stage that
+// makes the frame's image (the composite of FrameRenderer, or the relit frame), then the sinks
+// (window, truth comparison, ...) and the video. Commands only parse, build these and call Run().
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bake/bake.h"
+#include "capture/async_video_writer.h"
+#include "capture/frame_source.h"
+#include "estimation/frame_estimator.h"
+#include "scene/raycaster.h"
+#include "scene/scene.h"
+#include "scene/sun_tracker.h"
+
+namespace daylit::pipeline {
+
+// Which light a stage's image shows.
+enum class ImageLight {
+  kFrameLight,  // the frame's own (the composite): comparable with the recording's truth
+  kOtherLight,  // another sun or light (relit): not comparable
+};
+
+// One frame as the sinks see it, valid during the call only.
+struct PipelineFrame {
+  const capture::Frame& frame;                  // rgb empty: the frame could not be read
+  const estimation::FrameLight& light;          // its estimate (row: the CSV row)
+  const scene::TrackedSun& sun;
+  const std::vector<float>* image = nullptr;    // the stage's image (linear radiance, camera size); null
+                                                // without a stage or pixels
+  ImageLight image_light = ImageLight::kFrameLight;
+};
+
+// Makes each readable frame's image after its estimate (the only work that may need GL).
+class FrameStage {
+ public:
+  virtual ~FrameStage() = default;
+  // `image` is resized by the stage to width × height × 3; it may hold the previous frame's.
+  virtual ImageLight Process(const capture::Frame& frame, const estimation::FrameLight& light,
+                             const scene::TrackedSun& sun, std::vector<float>* image) = 0;
+};
+
+struct PipelineRun;
+
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+  // Every frame in order, readable or not, on the pipeline's thread.
+  virtual void Consume(const PipelineFrame& frame) = 0;
+  // True once the sink wants the run to end (a closed window).
+  virtual bool StopRequested() const { return false; }
+};
+
+struct LightingPipelineOptions {
+  estimation::FrameEstimatorOptions estimator;
+  scene::SunTrackerOptions sun;
+  std::optional<int> max_frames;         // ≥ 1: stop after this many (a live camera runs until stopped)
+  // Frames numbered below this are estimated (the filter needs them) but not handed to the stage,
+  // the sinks or the video (daylit relight --frames a:b).
+  std::optional<int> first_output_frame;
+  const std::atomic<bool>* stop = nullptr;  // set (Ctrl-C) to end the run after the frame at hand
+  std::string progress_label = "estimate";
+
+  // Empty when valid, else the first problem, naming the field.
+  std::string Check() const;
+};
+
+struct PipelineRun {
+  std::vector<estimation::FrameEstimate> frames;  // every frame read, in order
+  int undecodable = 0;
+  double seconds = 0.0;              // wall time of the loop, decoding (on its own thread) included
+  double median_estimate_ms = 0.0;   // the estimate after decoding, median over frames without a sun move
+  std::vector<double> sun_moves_ms;  // the estimate of frames with one: shadow rays, strata, transfer terms
+  double median_stage_ms = 0.0;      // the stage (relight, render), median over frames that had it
+};
+
+class LightingPipeline {
+ public:
+  // `options` must Check() empty (the commands validate them first: CHECK). `caster` is over
+  // the scene's model, shared with the stage; all three are kept by reference.
+  LightingPipeline(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                   const LightingPipelineOptions& options);
+
+  // Optional; not owned. Without a stage the pipeline only estimates (daylit estimate).
+  void SetStage(FrameStage* stage) { stage_ = stage; }
+  void AddSink(FrameSink* sink) { sinks_.push_back(sink); }
+  // Optional; not owned: each output frame's image is written to it (a repeat of the last frame
+  // for one that could not be read). Needs a stage.
+  void SetVideo(capture::AsyncVideoWriter* video) { video_ = video; }
+
+  // Runs over `source` until its end, `max_frames`, `stop` or a sink's stop. A frame that cannot
+  // be read holds the estimate; while a camera is unplugged nothing comes and the estimate holds.
+  PipelineRun Run(std::unique_ptr<capture::FrameSource> source);
+
+ private:
+  bool StopRequested() const;
+  // The stage, the sinks and the video for one frame; the stage's time in ms, or < 0 without one.
+  double Deliver(const capture::Frame& frame, const estimation::FrameLight& light, const scene::TrackedSun& sun);
+
+  const scene::Scene& scene_;
+  const bake::SceneBake& bake_;
+  const scene::RayCaster& caster_;
+  LightingPipelineOptions options_;
+  FrameStage* stage_ = nullptr;
+  std::vector<FrameSink*> sinks_;
+  capture::AsyncVideoWriter* video_ = nullptr;
+  std::vector<float> image_;
+};
+
+}  // namespace daylit::pipeline

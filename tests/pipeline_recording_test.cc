@@ -1,0 +1,119 @@
+// pipeline::LightingPipeline over the bundled recording: the frame loop hands every frame from
+// first_output_frame on, in order, to the stage (readable frames only) and then to the sinks; a
+// sink's stop and the stop flag end the run after the frame at hand; the estimates do not depend
+// on whether a stage or sinks are attached.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <vector>
+
+#include "pipeline/lighting_pipeline.h"
+#include "scene/raycaster.h"
+#include "tests/courtyard_fixture.h"
+
+namespace daylit::pipeline {
+namespace {
+
+// The frame's own pixels, scaled: a stage that needs no GL.
+class ScaleStage final : public FrameStage {
+ public:
+  ImageLight Process(const capture::Frame& frame, const estimation::FrameLight&, const scene::TrackedSun&,
+                     std::vector<float>* image) override {
+    const float* rgb = frame.rgb.ptr<float>();
+    image->assign(rgb, rgb + frame.rgb.total() * 3);
+    for (float& v : *image) v *= 2.0f;
+    ++calls;
+    return ImageLight::kOtherLight;
+  }
+  int calls = 0;
+};
+
+struct Seen {
+  int frame;
+  double first_value;
+  double sky_r;
+  int generation;
+};
+
+class RecordingSink final : public FrameSink {
+ public:
+  explicit RecordingSink(int stop_after = -1) : stop_after_(stop_after) {}
+  void Consume(const PipelineFrame& f) override {
+    ASSERT_NE(f.image, nullptr) << f.frame.index;
+    EXPECT_EQ(f.image_light, ImageLight::kOtherLight);
+    EXPECT_EQ(f.light.row.frame, f.frame.index);
+    seen.push_back({f.frame.index, (*f.image)[0] / (2.0 * f.frame.rgb.ptr<float>()[0]), f.light.row.light.sky_rgb.x,
+                    f.sun.generation});
+  }
+  bool StopRequested() const override { return stop_after_ >= 0 && static_cast<int>(seen.size()) >= stop_after_; }
+  std::vector<Seen> seen;
+
+ private:
+  int stop_after_;
+};
+
+TEST(PipelineRecordingTest, HandsEveryOutputFrameInOrderToTheStageAndTheSinks) {
+  const testing::BundledCourtyard& c = testing::Courtyard();
+  const scene::RayCaster caster(c.scene.model);
+  LightingPipelineOptions options;
+  options.max_frames = 40;
+  options.first_output_frame = 15;
+  LightingPipeline bare(c.scene, c.bake, caster, options);
+  const PipelineRun alone = bare.Run(scene::OpenFrameSource(c.scene));
+
+  LightingPipeline lighting(c.scene, c.bake, caster, options);
+  ScaleStage stage;
+  RecordingSink first, second;
+  lighting.SetStage(&stage);
+  lighting.AddSink(&first);
+  lighting.AddSink(&second);
+  const PipelineRun run = lighting.Run(scene::OpenFrameSource(c.scene));
+  ASSERT_EQ(run.frames.size(), 40u);
+  EXPECT_EQ(run.undecodable, 0);
+  EXPECT_EQ(stage.calls, 25);
+  ASSERT_EQ(first.seen.size(), 25u);
+  ASSERT_EQ(second.seen.size(), 25u);
+  for (size_t i = 0; i < first.seen.size(); ++i) {
+    EXPECT_EQ(first.seen[i].frame, 15 + static_cast<int>(i));
+    EXPECT_NEAR(first.seen[i].first_value, 1.0, 1e-6);  // the stage's image of this very frame
+    EXPECT_EQ(first.seen[i].sky_r, run.frames[15 + i].light.sky_rgb.x);
+    EXPECT_EQ(second.seen[i].frame, first.seen[i].frame);
+  }
+  // 40 frames at 10 fps: one burst, the sun counted as moved only at the start.
+  EXPECT_EQ(first.seen.back().generation, 1);
+  EXPECT_EQ(run.sun_moves_ms.size(), 1u);
+  EXPECT_GT(run.median_stage_ms, 0.0);
+  for (size_t i = 0; i < run.frames.size(); ++i) {
+    EXPECT_EQ(run.frames[i].light.sun_rgb.y, alone.frames[i].light.sun_rgb.y) << i;
+    EXPECT_EQ(run.frames[i].light.sky_rgb.z, alone.frames[i].light.sky_rgb.z) << i;
+  }
+}
+
+TEST(PipelineRecordingTest, ASinksStopOrTheStopFlagEndsTheRunAfterTheFrameAtHand) {
+  const testing::BundledCourtyard& c = testing::Courtyard();
+  const scene::RayCaster caster(c.scene.model);
+  ScaleStage stage;
+  RecordingSink closing(7);
+  LightingPipeline lighting(c.scene, c.bake, caster, {});
+  lighting.SetStage(&stage);
+  lighting.AddSink(&closing);
+  EXPECT_EQ(lighting.Run(scene::OpenFrameSource(c.scene)).frames.size(), 7u);
+
+  std::atomic<bool> stop{true};
+  LightingPipelineOptions options;
+  options.stop = &stop;
+  LightingPipeline stopped(c.scene, c.bake, caster, options);
+  EXPECT_TRUE(stopped.Run(scene::OpenFrameSource(c.scene)).frames.empty());
+}
+
+TEST(PipelineRecordingTest, OptionsAreCheckedBeforeAnyWork) {
+  LightingPipelineOptions options;
+  options.max_frames = 0;
+  EXPECT_NE(options.Check().find("max_frames"), std::string::npos);
+  options.max_frames = 3;
+  options.sun.move_threshold_deg = -1.0;
+  EXPECT_NE(options.Check().find("sun.move_threshold_deg"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace daylit::pipeline
