@@ -30,9 +30,8 @@ Sampler::Sampler(const bake::SceneBake& bake, const glm::vec3& capture_position,
 }
 
 bool Sampler::SetSun(const glm::vec3& sun_dir) {
-  if (sun_ && glm::degrees(std::acos(std::clamp(glm::dot(*sun_, sun_dir), -1.0f, 1.0f))) <= options_.recast_angle_deg) {
-    return false;
-  }
+  // The caller decides when the sun has moved (scene::SunTracker): any other sun is re-cast.
+  if (sun_ && *sun_ == sun_dir) return false;
   sun_ = sun_dir;
   const int w = gbuffer_.width, h = gbuffer_.height;
   // Sun visibility of every model pixel (not only diffuse ones), so that the shadow map in the

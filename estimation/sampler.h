@@ -1,9 +1,9 @@
 // Which camera pixels the per-frame fit reads. Stratified across surfaces and across sunlit and
 // shadowed areas (the two strata are what separates E_sun from E_sky), skipping pixels near a
 // shadow edge or a silhouette of the model (misregistration there is the main error source) and,
-// per frame, saturated and near-black pixels. The sun visibility behind the strata is re-cast only when the
-// sun has moved more than `recast_angle_deg`; so are the transfer terms (estimation/transfer.h) of the
-// pixels each stratum may use.
+// per frame, saturated and near-black pixels. The sun visibility behind the strata is re-cast only for another
+// sun (the pipeline's scene::SunTracker hands the same direction until the sun has moved); so are
+// the transfer terms (estimation/transfer.h) of the pixels each stratum may use.
 #pragma once
 
 #include <cstdint>
@@ -24,7 +24,6 @@ namespace daylit::estimation {
 struct SamplerOptions {
   int samples = 8000;                // per frame, split evenly over the strata that exist
   int boundary_margin_px = 3;        // pixels this close to a shadow edge or silhouette are left out
-  double recast_angle_deg = 0.05;    // re-cast sun visibility when the sun moved more than this
   double saturated = 0.98;           // linear pixel value (before exposure) treated as clipped
   double near_black = 0.002;         // linear pixel value below which noise dominates
   double pool = 1.5;                 // pixels per stratum given transfer terms, in units of its quota

@@ -116,11 +116,15 @@ TEST(SamplerTest, ShadowEdgesClippedAndDarkPixelsAreLeftOut) {
   EXPECT_TRUE(sampler.Draw(cv::Mat(frame.size(), CV_32FC3, cv::Scalar(0, 0, 0)), 0.004).empty());
 }
 
-TEST(SamplerTest, SunVisibilityIsRecastOnlyWhenTheSunMoves) {
+// The pipeline's scene::SunTracker hands the same direction until the sun has moved; the sampler
+// re-casts for any other direction, however close, and never for the same one.
+TEST(SamplerTest, SunVisibilityIsRecastOnlyForAnotherSun) {
   const WallScene w;
   Sampler sampler(w.bake, w.Capture(), *w.caster, WallScene::SeedModel());
   EXPECT_TRUE(sampler.SetSun(w.sun));
+  EXPECT_FALSE(sampler.SetSun(w.sun));
   const glm::vec3 tiny = glm::normalize(w.sun + glm::vec3(0.0f, 0.0005f, 0.0f));  // 0.02°
+  EXPECT_TRUE(sampler.SetSun(tiny));
   EXPECT_FALSE(sampler.SetSun(tiny));
   const glm::vec3 moved = glm::normalize(w.sun + glm::vec3(0.0f, 0.005f, 0.0f));  // 0.2°
   EXPECT_TRUE(sampler.SetSun(moved));

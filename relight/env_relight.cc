@@ -29,7 +29,7 @@ EnvRelighter::EnvRelighter(const bake::SceneBake& bake, const glm::vec3& capture
 }
 
 bool EnvRelighter::SetSun(const glm::vec3& sun_dir) {
-  if (sun_ && glm::degrees(std::acos(std::clamp(glm::dot(*sun_, sun_dir), -1.0f, 1.0f))) <= 0.05f) return false;
+  if (sun_ && *sun_ == sun_dir) return false;  // the caller decides when it moved (scene::SunTracker)
   sun_ = sun_dir;
   surface_.Compute(sun_dir, &terms_);
   // The sky's shape per sky texel.

@@ -56,9 +56,8 @@ void ImageRelighter::Fill(const glm::vec3& sun_dir, PixelTerms* terms) {
 }
 
 bool ImageRelighter::SetSuns(const glm::vec3& now, const glm::vec3& next) {
-  const auto moved = [](const std::optional<glm::vec3>& from, const glm::vec3& to) {
-    return !from || glm::degrees(std::acos(std::clamp(glm::dot(*from, to), -1.0f, 1.0f))) > 0.05f;
-  };
+  // The caller decides when a sun has moved (scene::SunTracker): any other sun is redone.
+  const auto moved = [](const std::optional<glm::vec3>& from, const glm::vec3& to) { return !from || *from != to; };
   const bool now_moved = moved(now_sun_, now), next_moved = moved(next_sun_, next);
   if (now_moved) Fill(now, &terms_.now), now_sun_ = now, terms_.now_sun = now;
   if (next_moved) Fill(next, &terms_.next), next_sun_ = next;

@@ -63,7 +63,7 @@ ObjectBounce::ObjectBounce(const scene::Scene& scene, const bake::SceneBake& bak
 
 bool ObjectBounce::SetSun(const glm::vec3& sun_dir) {
   const glm::vec3 sun = glm::normalize(sun_dir);
-  if (has_sun_ && glm::dot(sun, sun_) > std::cos(glm::radians(0.05f))) return false;
+  if (has_sun_ && sun == sun_) return false;  // the caller decides when it moved (scene::SunTracker)
   sun_ = sun, has_sun_ = true;
   std::vector<float> lost(seen_.size(), 0.0f);  // cos_y (s_y − s'_y)
   tbb::parallel_for(tbb::blocked_range<size_t>(0, seen_.size(), 256), [&](const tbb::blocked_range<size_t>& range) {

@@ -128,7 +128,7 @@ void ObjectShadows::SetEnvBasis(const EnvBasis& basis) {
 
 bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
   const glm::vec3 sun = glm::normalize(sun_dir);
-  if (has_sun_ && glm::dot(sun, sun_) > std::cos(glm::radians(0.05f))) return false;
+  if (has_sun_ && sun == sun_) return false;  // the caller decides when it moved (scene::SunTracker)
   sun_ = sun, has_sun_ = true;
   // Directions over the sun's disc (radius 0.2665°), a Fibonacci spiral of equal areas.
   disc_.clear();

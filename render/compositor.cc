@@ -397,8 +397,8 @@ void Compositor::Render(const CompositeInput& input, float* image) {
   if (r.width == 0) return;  // no objects in view
   const glm::vec3 sun = glm::normalize(input.sun_dir);
   const bool sun_up = sun.z > 0.0f;
-  // The sun's shadow map, redrawn when the sun has moved more than 0.05°.
-  if (sun_up && (!g.has_shadow_map || glm::dot(sun, g.shadow_sun) < std::cos(glm::radians(0.05f)))) {
+  // The sun's shadow map, redrawn for another sun (scene::SunTracker says when it moved).
+  if (sun_up && (!g.has_shadow_map || sun != g.shadow_sun)) {
     g.has_shadow_map = true;
     g.shadow_sun = sun;
     const ShadowView view = ShadowViewOf(sun, g.objects_lo, g.objects_hi, g.model_lo, g.model_hi, g.options.shadow_map_size);

@@ -31,10 +31,10 @@ SunTracker::SunTracker(const Scene& scene, const SunTrackerOptions& options)
 
 const TrackedSun& SunTracker::Update(const UtcTime& utc) {
   sun_.position = sunmodel::ComputeSunPosition(utc, site_, atmosphere_, {});
-  sun_.dir_in_scene = glm::vec3(geo_.DirectionInScene(sun_.position.azimuth_deg, sun_.position.apparent_zenith_deg));
-  sun_.moved = sun_.generation == 0 || SunMoved(last_moved_dir_, sun_.dir_in_scene, options_.move_threshold_deg);
+  const glm::vec3 own(geo_.DirectionInScene(sun_.position.azimuth_deg, sun_.position.apparent_zenith_deg));
+  sun_.moved = sun_.generation == 0 || SunMoved(sun_.dir_in_scene, own, options_.move_threshold_deg);
   if (sun_.moved) {
-    last_moved_dir_ = sun_.dir_in_scene;
+    sun_.dir_in_scene = own;
     ++sun_.generation;
   }
   return sun_;

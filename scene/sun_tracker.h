@@ -30,7 +30,10 @@ bool SunMoved(const glm::vec3& from, const glm::vec3& to, double threshold_deg);
 
 struct TrackedSun {
   sunmodel::SunPosition position;   // at the frame's own time (apparent zenith, azimuth east of north)
-  glm::vec3 dir_in_scene{0.0f, 0.0f, 1.0f};  // unit vector toward the sun at the frame's own time
+  // Unit vector toward the sun as every stage uses it: the frame's own direction when `moved`,
+  // else that of the last frame that moved (within move_threshold_deg of the frame's own).
+  // Stages redo their sun-dependent work when it changes, and only then.
+  glm::vec3 dir_in_scene{0.0f, 0.0f, 1.0f};
   bool moved = true;                // the first update, or SunMoved since the last update that moved
   int generation = 0;               // counts the updates that moved, from 1
 };
@@ -51,7 +54,6 @@ class SunTracker {
   sunmodel::SceneGeoFrame geo_;
   SunTrackerOptions options_;
   TrackedSun sun_;
-  glm::vec3 last_moved_dir_{0.0f};
 };
 
 }  // namespace daylit::scene
