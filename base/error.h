@@ -1,5 +1,6 @@
 // Errors caused by what the user gave us (files, fields, values). The command line prints the
-// message on one line and exits with kInputErrorExitCode; nothing else catches these.
+// message on one line and exits with kInputErrorExitCode; nothing else catches these. Broken
+// invariants are DAYLIT_CHECK (base/check.h); expected outcomes of real data are status values.
 #pragma once
 
 #include <stdexcept>
@@ -20,6 +21,18 @@ class InputError : public std::runtime_error {
 template <typename... Args>
 [[noreturn]] void ThrowInputError(fmt::format_string<Args...> format, Args&&... args) {
   throw InputError(fmt::format(format, std::forward<Args>(args)...));
+}
+
+// The machine, not the input and not daylit: a GL driver without what daylit needs, a device that
+// fails. The command line prints the message on one line and exits with 1.
+class SystemError : public std::runtime_error {
+ public:
+  explicit SystemError(const std::string& message) : std::runtime_error(message) {}
+};
+
+template <typename... Args>
+[[noreturn]] void ThrowSystemError(fmt::format_string<Args...> format, Args&&... args) {
+  throw SystemError(fmt::format(format, std::forward<Args>(args)...));
 }
 
 }  // namespace daylit

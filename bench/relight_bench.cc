@@ -9,10 +9,10 @@
 #include "bake/sampling.h"
 #include "base/log.h"
 #include "relight/env_relight.h"
-#include "relight/exact_irradiance.h"
-#include "relight/irradiance_volume.h"
-#include "relight/light_fit.h"
-#include "relight/lights.h"
+#include "sh/exact_irradiance.h"
+#include "sh/irradiance_volume.h"
+#include "lightfit/light_fit.h"
+#include "lightfit/lights.h"
 #include "scene/scene.h"
 #include "scene/latlong.h"
 
@@ -45,7 +45,7 @@ void BM_VolumeUpdate512Probes(benchmark::State& state) {
   std::uniform_real_distribution<float> radiance(0.0f, 10.0f);
   std::vector<glm::vec3> env(1024 * 512);
   for (glm::vec3& l : env) l = glm::vec3(radiance(rng), radiance(rng), radiance(rng));
-  IrradianceVolume volume(gather);
+  sh::IrradianceVolume volume(gather);
   for (auto _ : state) {
     volume.Update(env);
     benchmark::DoNotOptimize(volume.coefficients().data());
@@ -58,14 +58,14 @@ BENCHMARK(BM_VolumeUpdate512Probes)->Arg(256)->Arg(512)->Unit(benchmark::kMillis
 // irradiance map (bar ≤ 60 s; HDRShop took 24 hours) from a 1024×512 probe, on 2 cores.
 void BM_ExactIrradiance20480(benchmark::State& state) {
   const scene::HdrImage probe = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
-  const std::vector<glm::vec3> normals = IcosahedronNormals(5);
-  for (auto _ : state) benchmark::DoNotOptimize(ExactIrradiance(probe, normals).data());
+  const std::vector<glm::vec3> normals = sh::IcosahedronNormals(5);
+  for (auto _ : state) benchmark::DoNotOptimize(sh::ExactIrradiance(probe, normals).data());
 }
 BENCHMARK(BM_ExactIrradiance20480)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_ExactIrradianceMap1024x512(benchmark::State& state) {
   const scene::HdrImage probe = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
-  for (auto _ : state) benchmark::DoNotOptimize(ExactIrradianceMap(probe, 1024, 512).data());
+  for (auto _ : state) benchmark::DoNotOptimize(sh::ExactIrradianceMap(probe, 1024, 512).data());
 }
 BENCHMARK(BM_ExactIrradianceMap1024x512)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
@@ -76,7 +76,7 @@ void BM_IrradianceOptimization(benchmark::State& state, const char* file) {
   const scene::HdrImage probe = scene::ReadHdrImage(std::string(DAYLIT_SOURCE_DIR "/probes/") + file);
   int iterations = 0;
   for (auto _ : state) {
-    const LightFitResult fit = IrradianceOptimization(probe, static_cast<int>(state.range(0)));
+    const lightfit::LightFitResult fit = lightfit::IrradianceOptimization(probe, static_cast<int>(state.range(0)));
     iterations = fit.iterations;
     benchmark::DoNotOptimize(fit.lights.lights.data());
   }
@@ -89,7 +89,7 @@ BENCHMARK_CAPTURE(BM_IrradianceOptimization, rooitou, "rooitou_park_1k.hdr")
 
 void BM_MedianCut(benchmark::State& state) {
   const scene::HdrImage probe = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
-  for (auto _ : state) benchmark::DoNotOptimize(MedianCutLights(probe, static_cast<int>(state.range(0))).lights.data());
+  for (auto _ : state) benchmark::DoNotOptimize(lightfit::MedianCutLights(probe, static_cast<int>(state.range(0))).lights.data());
 }
 BENCHMARK(BM_MedianCut)->Arg(8)->Arg(128)->Unit(benchmark::kMillisecond);
 

@@ -14,9 +14,9 @@
 #include "render/frame_renderer.h"
 #include "render/gl_context.h"
 #include "render/image_relight_gl.h"
-#include "relight/env_lights.h"
+#include "lightfit/env_lights.h"
 #include "relight/image_relight.h"
-#include "relight/object_shadows.h"
+#include "composite/object_shadows.h"
 #include "scene/object_mesh.h"
 #include "capture/frame_source.h"
 #include "scene/scene.h"
@@ -83,13 +83,13 @@ void BM_RenderFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_RenderFrame)->Arg(0)->Arg(2)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// The objects' shadows and sky loss on the real surfaces (relight::ObjectShadows), on the CPU:
+// The objects' shadows and sky loss on the real surfaces (composite::ObjectShadows), on the CPU:
 // per frame (B from the frame, the loss for its light; 310k of the 518k pixels on
 // courtyard-a), and per sun move (the sun rays past the objects' bounding spheres).
 struct CourtyardShadows {
   scene::SceneModel model;
   scene::RayCaster objects;
-  relight::ObjectShadows shadows;
+  composite::ObjectShadows shadows;
   std::vector<float> linear;
 
   explicit CourtyardShadows(Courtyard& c)
@@ -141,7 +141,7 @@ void BM_FitEnvLights(benchmark::State& state) {
   relighter.Basis(&basis);
   glm::vec3 lo, hi;
   scene::ObjectsModel(c.scene.objects).Bounds(&lo, &hi);
-  relight::EnvLights lights(static_cast<int>(state.range(0)), *c.caster, 0.5f * (lo + hi), glm::vec3(c.scene.envmap->position),
+  lightfit::EnvLights lights(static_cast<int>(state.range(0)), *c.caster, 0.5f * (lo + hi), glm::vec3(c.scene.envmap->position),
                             c.bake.env.width, c.bake.env.height);
   const relight::LightParts parts = relight::SplitLight(c.fit.fit.light, c.fit.fit.overcast_share);
   for (auto _ : state) {

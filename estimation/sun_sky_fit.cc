@@ -131,6 +131,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   // One channel: E_sun and E_sky, or, with `split`, E_sun, E_clear and E_overcast; else the sky's
   // regressor is the clear one and the overcast one mixed by `share`. `start`, if given, replaces
   // the median-based start. Fits the samples `rows`.
+  int unconverged_channels = 0;  // final fits that ran out of IRLS iterations
   const auto fit_channel = [&](int c, bool split, double share, const ChannelFit* start,
                                const std::vector<size_t>& rows) {
     const size_t m = rows.size();
@@ -199,14 +200,16 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
     // Until the estimate moves less than `tolerance` (relative). The split only feeds the pooled
     // overcast share, so it stops sooner.
     const double tolerance = split ? 1e-3 : 1e-4;
-    for (int iteration = 0; iteration < options.iterations; ++iteration) {
+    bool converged = false;
+    for (int iteration = 0; iteration < options.iterations && !converged; ++iteration) {
       const ChannelFit next = SolveNonNegative(reweighted(), free);
       double change = 0.0;
       const double size = std::max({next[0], next[1] + next[2], 1e-30});
       for (size_t j = 0; j < 3; ++j) change = std::max(change, std::abs(next[j] - fit[j]) / size);
       fit = next;
-      if (change < tolerance) break;
+      converged = change < tolerance;
     }
+    if (!split && !converged) ++unconverged_channels;
     for (size_t k = 0; k < m; ++k) {
       const double prediction = predict(k);
       relative[k] = (y[k] - prediction) / std::max(prediction, floor);
@@ -255,9 +258,15 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   const double strata = std::min(1.0, static_cast<double>(summary.shadowed_samples) / options.min_stratum_samples) *
                         (with_sun ? std::min(1.0, static_cast<double>(summary.sunlit_samples) / options.min_stratum_samples) : 1.0);
   summary.confidence = fit_quality * strata * summary.inlier_share;
-  summary.status = with_sun ? SunSkyFitStatus::kConverged : SunSkyFitStatus::kSkyOnly;
-  summary.message = fmt::format("{} samples ({} sunlit, {} shadowed), residual spread {:.3f}", n,
-                                summary.sunlit_samples, summary.shadowed_samples, summary.residual_spread);
+  summary.status = unconverged_channels > 0 ? SunSkyFitStatus::kNoConvergence
+                   : with_sun                ? SunSkyFitStatus::kConverged
+                                             : SunSkyFitStatus::kSkyOnly;
+  summary.message = fmt::format("{} samples ({} sunlit, {} shadowed), residual spread {:.3f}{}", n,
+                                summary.sunlit_samples, summary.shadowed_samples, summary.residual_spread,
+                                unconverged_channels > 0
+                                    ? fmt::format("; {} of 3 channels still moving after {} iterations",
+                                                  unconverged_channels, options.iterations)
+                                    : std::string());
   return summary;
 }
 

@@ -101,6 +101,22 @@ TEST(SunSkyFitTest, OutliersAndAMovingOccluderDoNotMoveTheEstimate) {
   EXPECT_LT(fit.inlier_share, 0.8);  // the outliers are seen as such
 }
 
+// With outliers the reweighting needs several iterations; cut to one it stops while the estimate
+// still moves, and says so: usable, but not kConverged.
+TEST(SunSkyFitTest, RunningOutOfIterationsIsNoConvergence) {
+  std::mt19937 rng(3);
+  std::vector<Sample> samples = MakeSamples(kClear, 5000, rng);
+  std::uniform_real_distribution<float> wild(0.0f, 40.0f);
+  for (size_t i = 0; i < samples.size(); i += 10) samples[i].radiance = {wild(rng), wild(rng), wild(rng)};
+  EXPECT_EQ(FitSunSky({}, samples).status, SunSkyFitStatus::kConverged);
+  SunSkyFitOptions one;
+  one.iterations = 1;
+  const SunSkyFitSummary cut = FitSunSky(one, samples);
+  EXPECT_EQ(cut.status, SunSkyFitStatus::kNoConvergence) << cut.message;
+  EXPECT_TRUE(cut.IsUsable());
+  EXPECT_NE(cut.message.find("still moving after 1 iterations"), std::string::npos) << cut.message;
+}
+
 TEST(SunSkyFitTest, OvercastGivesNoSunWithConfidence) {
   // Sunlit and shadowed areas look alike: E_sun must come out ≈ 0, not noise.
   std::mt19937 rng(4);

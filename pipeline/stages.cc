@@ -5,7 +5,7 @@
 namespace daylit::pipeline {
 
 CompositeStage::CompositeStage(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
-                               render::FrameRenderer* renderer, const relight::TimeSlider* slider)
+                               render::FrameRenderer* renderer, const render::TimeSlider* slider)
     : scene_(scene), bake_(bake), caster_(caster), renderer_(*renderer), slider_(slider) {}
 
 ImageLight CompositeStage::Process(const capture::Frame& frame, const estimation::FrameLight& light,

@@ -9,7 +9,7 @@
 #include "pipeline/lighting_pipeline.h"
 #include "relight/image_relight.h"
 #include "relight/new_light.h"
-#include "relight/time_slider.h"
+#include "render/time_slider.h"
 #include "render/frame_renderer.h"
 #include "render/image_relight_gl.h"
 
@@ -20,7 +20,7 @@ class CompositeStage final : public FrameStage {
   // All kept by reference. `slider` (optional) is read at each frame: while it has a target
   // time, the frame is relit to it (relight::ImageRelighter, made when first needed).
   CompositeStage(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
-                 render::FrameRenderer* renderer, const relight::TimeSlider* slider = nullptr);
+                 render::FrameRenderer* renderer, const render::TimeSlider* slider = nullptr);
   ImageLight Process(const capture::Frame& frame, const estimation::FrameLight& light, const scene::TrackedSun& sun,
                      std::vector<float>* image) override;
 
@@ -29,7 +29,7 @@ class CompositeStage final : public FrameStage {
   const bake::SceneBake& bake_;
   const scene::RayCaster& caster_;
   render::FrameRenderer& renderer_;
-  const relight::TimeSlider* slider_;
+  const render::TimeSlider* slider_;
   std::unique_ptr<relight::ImageRelighter> relighter_;
 };
 

@@ -6,7 +6,7 @@
 
 namespace daylit::pipeline {
 
-WindowSink::WindowSink(const scene::Scene& scene, render::GlWindow* window, relight::TimeSlider* slider)
+WindowSink::WindowSink(const scene::Scene& scene, render::GlWindow* window, render::TimeSlider* slider)
     : scene_(scene),
       window_(*window),
       slider_(*slider),

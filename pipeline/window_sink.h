@@ -8,7 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "pipeline/lighting_pipeline.h"
-#include "relight/time_slider.h"
+#include "render/time_slider.h"
 #include "render/gl_window.h"
 #include "render/window_overlay.h"
 
@@ -17,14 +17,14 @@ namespace daylit::pipeline {
 class WindowSink final : public FrameSink {
  public:
   // All kept by reference; `slider` is the one the CompositeStage reads.
-  WindowSink(const scene::Scene& scene, render::GlWindow* window, relight::TimeSlider* slider);
+  WindowSink(const scene::Scene& scene, render::GlWindow* window, render::TimeSlider* slider);
   void Consume(const PipelineFrame& frame) override;
   bool StopRequested() const override { return closed_; }
 
  private:
   const scene::Scene& scene_;
   render::GlWindow& window_;
-  relight::TimeSlider& slider_;
+  render::TimeSlider& slider_;
   const capture::Encoder to_screen_;
   cv::Mat shown_rgb_, shown_;
   std::chrono::steady_clock::time_point last_shown_;

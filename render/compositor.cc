@@ -9,18 +9,19 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "base/check.h"
 #include "base/error.h"
 #include "render/gl_program.h"
 #include "render/projection.h"
-#include "relight/env_lights.h"
-#include "relight/irradiance_volume.h"
+#include "lightfit/env_lights.h"
+#include "sh/irradiance_volume.h"
 #include "scene/object_mesh.h"
 
 namespace daylit::render {
 namespace {
 
 constexpr float kNear = 0.05f, kFar = 2000.0f;
-constexpr int kMaxLights = relight::EnvLights::kMaxLights;
+constexpr int kMaxLights = lightfit::EnvLights::kMaxLights;
 
 const char* kDepthVertex = R"(#version 330 core
 layout(location = 0) in vec3 position;
@@ -51,7 +52,7 @@ void main() {
   gl_Position = clip_from_world * vec4(position, 1.0);
 })";
 
-// ρ/π (E_sun v max(0, n·l) + Σ_c SH_c(p) Y_c(n)); Y_c as relight/sh9.h (the cosine lobe is in
+// ρ/π (E_sun v max(0, n·l) + Σ_c SH_c(p) Y_c(n)); Y_c as sh/sh9.h (the cosine lobe is in
 // the coefficients already). SH_c(p): the volume's trilinear coefficients at the vertices,
 // interpolated across the triangle (meshes are finer than the probe grid; the builtin ones are),
 // evaluated with the fragment's own normal.
@@ -72,7 +73,7 @@ uniform sampler2DShadow shadow_map;
 uniform float shadow_texel;
 uniform bool has_volume;
 #if LIGHTS > 0
-// Instead of the volume: directional lights and an ambient term (relight::EnvLights), each light
+// Instead of the volume: directional lights and an ambient term (lightfit::EnvLights), each light
 // with its own shadow map, a layer of light_maps.
 uniform vec3 ambient;
 uniform vec3 light_dir[LIGHTS];
@@ -130,7 +131,7 @@ void main() {
     }
   }
 #endif
-  // The bounce from real ground the objects themselves shade (relight::ObjectBounce; zero
+  // The bounce from real ground the objects themselves shade (composite::ObjectBounce; zero
   // unless set).
   e -= sun_rgb * vertex_sun_loss + sky_rgb * vertex_sky_loss;
   color = vec4(albedo / kPi * max(e, vec3(0.0)), 1.0);
@@ -310,7 +311,7 @@ Compositor::Rect ProjectedRect(const std::vector<glm::vec3>& vertices, const glm
 Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& options) : gl_(std::make_unique<Gl>()) {
   Gl& g = *gl_;
   g.options = options;
-  if (options.lights < 0 || options.lights > kMaxLights) ThrowInputError("Compositor: {} lights; 0 to {}", options.lights, kMaxLights);
+  DAYLIT_CHECK(options.lights >= 0 && options.lights <= kMaxLights, "{} lights; 0 to {}", options.lights, kMaxLights);
   const std::string fragment = fmt::format("#version 330 core\n#define LIGHTS {}\n", options.lights) + kObjectFragment;
   g.object_program = std::make_unique<GlProgram>(kObjectVertex, fragment.c_str());
   g.width = scene.intrinsics.width, g.height = scene.intrinsics.height;
@@ -343,7 +344,7 @@ Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& optio
   glBindFramebuffer(GL_FRAMEBUFFER, g.msaa.get());
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, g.msaa_color.get());
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, g.msaa_depth.get());
-  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) ThrowInputError("OpenGL: no {}× MSAA float framebuffer", options.samples);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) ThrowSystemError("OpenGL: no {}× MSAA float framebuffer", options.samples);
   glBindRenderbuffer(GL_RENDERBUFFER, g.resolved_color.get());
   glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, rw, rh);
   glBindFramebuffer(GL_FRAMEBUFFER, g.resolved.get());
@@ -365,7 +366,7 @@ Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& optio
     SetShadowSampling(GL_TEXTURE_2D_ARRAY);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  if (glGetError() != GL_NO_ERROR) ThrowInputError("OpenGL: setting up the compositor failed");
+  if (glGetError() != GL_NO_ERROR) ThrowSystemError("OpenGL: setting up the compositor failed");
 }
 
 Compositor::~Compositor() = default;
@@ -373,9 +374,8 @@ Compositor::~Compositor() = default;
 void Compositor::SetObjectLosses(const std::vector<glm::vec3>& sun_loss, const std::vector<glm::vec3>& sky_loss) {
   size_t vertices = 0;
   for (const DrawMesh& m : gl_->objects) vertices += m.vertices;
-  if (sun_loss.size() != vertices || sky_loss.size() != vertices) {
-    ThrowInputError("SetObjectLosses: {} and {} values for {} vertices (scene::ShadingMesh)", sun_loss.size(), sky_loss.size(), vertices);
-  }
+  DAYLIT_CHECK(sun_loss.size() == vertices && sky_loss.size() == vertices, "{} and {} values for {} vertices (scene::ShadingMesh)",
+               sun_loss.size(), sky_loss.size(), vertices);
   size_t offset = 0;
   for (const DrawMesh& m : gl_->objects) {
     glBindBuffer(GL_ARRAY_BUFFER, m.sun_loss.get());
@@ -411,9 +411,8 @@ void Compositor::Render(const CompositeInput& input, float* image) {
   // The lights' shadow maps, redrawn when their directions change. A light that stands for the
   // real model's reflected light is shadowed by the objects only.
   const int light_count = input.lights != nullptr ? static_cast<int>(input.lights->lights.size()) : 0;
-  if (light_count != 0 && light_count != g.options.lights) {
-    ThrowInputError("Compositor: {} lights given, made for {}", light_count, g.options.lights);
-  }
+  DAYLIT_CHECK(light_count == 0 || light_count == g.options.lights, "{} lights given, made for {}", light_count,
+               g.options.lights);
   if (light_count > 0 && input.lights_generation != g.light_generation) {
     const int size = g.options.light_shadow_map_size;
     g.light_generation = input.lights_generation;
@@ -485,7 +484,7 @@ void Compositor::Render(const CompositeInput& input, float* image) {
   glUniform1i(g.object_program->Uniform("has_volume"), has_volume ? 1 : 0);
   if (light_count > 0) {
     std::vector<glm::vec3> dirs, rgbs;
-    for (const relight::DirectionalLight& l : input.lights->lights) dirs.push_back(glm::normalize(l.direction)), rgbs.push_back(l.irradiance);
+    for (const lightfit::DirectionalLight& l : input.lights->lights) dirs.push_back(glm::normalize(l.direction)), rgbs.push_back(l.irradiance);
     glUniform3fv(g.object_program->Uniform("ambient"), 1, glm::value_ptr(input.lights->ambient));
     glUniform3fv(g.object_program->Uniform("light_dir"), light_count, glm::value_ptr(dirs[0]));
     glUniform3fv(g.object_program->Uniform("light_rgb"), light_count, glm::value_ptr(rgbs[0]));

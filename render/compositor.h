@@ -1,5 +1,5 @@
 // The virtual objects drawn into the camera frame in linear light (seed 001's rendering):
-//   - the background is the linear frame in radiance units, with relight::ObjectShadows already
+//   - the background is the linear frame in radiance units, with composite::ObjectShadows already
 //     applied (the objects' shadows and sky loss on real surfaces are computed per pixel on the
 //     CPU, from the bake's G-buffer);
 //   - the real model is drawn into depth only, a phantom, so real walls hide objects behind them;
@@ -22,8 +22,8 @@
 #include <glm/glm.hpp>
 
 #include "estimation/lighting_model.h"
-#include "relight/irradiance_volume.h"
-#include "relight/lights.h"
+#include "sh/irradiance_volume.h"
+#include "lightfit/lights.h"
 #include "scene/scene.h"
 
 namespace daylit::render {
@@ -31,11 +31,11 @@ namespace daylit::render {
 struct CompositeInput {
   estimation::SunSky light;           // E_sun (DNI) and E_sky, radiance units
   glm::vec3 sun_dir{0.0f, 0.0f, 1.0f};  // unit, toward the sun, scene coordinates
-  const relight::IrradianceVolume* volume = nullptr;  // updated for this frame; always the same one; null: no indirect light
-  // Instead of the volume (null), directional lights and an ambient term (relight::EnvLights;
+  const sh::IrradianceVolume* volume = nullptr;  // updated for this frame; always the same one; null: no indirect light
+  // Instead of the volume (null), directional lights and an ambient term (lightfit::EnvLights;
   // as many as CompositorOptions::lights), each with a shadow map; `lights_reflected` per light: 1 when only the objects shadow
   // it. Their shadow maps are redrawn when `lights_generation` changes.
-  const relight::LightSet* lights = nullptr;
+  const lightfit::LightSet* lights = nullptr;
   const std::vector<uint8_t>* lights_reflected = nullptr;
   int lights_generation = 0;
 };
@@ -58,7 +58,7 @@ class Compositor {
   int height() const;
 
   // The irradiance each object vertex loses per unit E_sun and per unit E_sky, all objects in
-  // scene::ShadingMesh order (relight::ObjectBounce); applied with the volume's light.
+  // scene::ShadingMesh order (composite::ObjectBounce); applied with the volume's light.
   void SetObjectLosses(const std::vector<glm::vec3>& sun_loss, const std::vector<glm::vec3>& sky_loss);
 
   // Draws the objects into `image`: camera-size linear RGB, row-major from the top row, holding

@@ -186,7 +186,7 @@ TEST(CompositorTest, LightsCastShadowsUnlessTheModelReflectsThem) {
   CompositorOptions one_light;
   one_light.lights = 1;
   Compositor compositor(s, one_light);
-  relight::LightSet lights;
+  lightfit::LightSet lights;
   lights.ambient = glm::vec3(0.1f, 0.2f, 0.3f);
   lights.lights = {{f.sun, glm::vec3(10.0f, 20.0f, 30.0f)}};
   std::vector<uint8_t> reflected = {0};

@@ -1,5 +1,6 @@
 #include "render/frame_renderer.h"
 
+#include "base/check.h"
 #include "base/error.h"
 #include "scene/object_mesh.h"
 
@@ -27,13 +28,13 @@ FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& b
       linearizer_(scene.response) {
   scene::CheckObjectsOutsideModel(objects_model_, caster, scene.file.string());
   if (options.lights == 0 && !bake.gather.directions.empty()) {
-    volume_ = std::make_unique<relight::IrradianceVolume>(bake.gather, relight::ProbesInsideModel(bake.gather, caster));
+    volume_ = std::make_unique<sh::IrradianceVolume>(bake.gather, sh::ProbesInsideModel(bake.gather, caster));
   }
   if (options.lights > 0 && !scene.objects.empty()) {
     if (!scene.envmap) ThrowInputError("{}: --lighting lights:{} needs the scene's envmap", scene.file.string(), options.lights);
     glm::vec3 lo, hi;
     objects_model_.Bounds(&lo, &hi);
-    env_lights_ = std::make_unique<relight::EnvLights>(options.lights, caster, 0.5f * (lo + hi),
+    env_lights_ = std::make_unique<lightfit::EnvLights>(options.lights, caster, 0.5f * (lo + hi),
                                                        glm::vec3(scene.envmap->position), bake.env.width, bake.env.height);
   }
 }
@@ -44,8 +45,8 @@ int ParseLighting(const std::string& text, const char* where) {
     const std::string n = text.substr(7);
     if (!n.empty() && n.size() <= 3 && n.find_first_not_of("0123456789") == std::string::npos) {
       const int count = std::stoi(n);
-      if (count >= 1 && count <= relight::EnvLights::kMaxLights) return count;
-      ThrowInputError("{}: {} lights; give 1 to {}", where, count, relight::EnvLights::kMaxLights);
+      if (count >= 1 && count <= lightfit::EnvLights::kMaxLights) return count;
+      ThrowInputError("{}: {} lights; give 1 to {}", where, count, lightfit::EnvLights::kMaxLights);
     }
   }
   ThrowInputError("{}: '{}' is not volume or lights:N", where, text);
@@ -53,7 +54,7 @@ int ParseLighting(const std::string& text, const char* where) {
 
 void FrameRenderer::Linearize(const capture::Frame& frame, std::vector<float>* linear) const {
   if (frame.rgb.cols != width() || frame.rgb.rows != height() || frame.rgb.type() != CV_32FC3) {
-    ThrowInputError("frame {}: {}x{}, not the camera's {}x{}", frame.index, frame.rgb.cols, frame.rgb.rows, width(), height());
+    DAYLIT_CHECK(false, "frame {}: {}x{}, not the camera's {}x{}", frame.index, frame.rgb.cols, frame.rgb.rows, width(), height());
   }
   capture::LinearRadiance(frame, linearizer_, linear);
 }
@@ -90,7 +91,7 @@ void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcas
     }
   }
   if (env_lights_) {
-    // The lights are fitted again when the combination has drifted too far (relight::EnvLights).
+    // The lights are fitted again when the combination has drifted too far (lightfit::EnvLights).
     input.lights = &env_lights_->Update(e);
     input.lights_reflected = &env_lights_->reflected();
     input.lights_generation = env_lights_->generation();

@@ -1,7 +1,7 @@
 // One frame of the augmented video, from a fitted frame (estimation::FitFrame or the replay's
 // estimate) to the composite in linear radiance units: the frame linearised with the camera
 // response and its exposure divided out, the objects' shadows and sky loss applied to the real
-// surfaces (relight::ObjectShadows), the environment map relit with the estimate and the
+// surfaces (composite::ObjectShadows), the environment map relit with the estimate and the
 // irradiance volume updated from it, then the objects drawn (Compositor). Needs a current GL
 // context; everything sun-dependent is recomputed only when the sun has moved.
 #pragma once
@@ -14,11 +14,11 @@
 #include "bake/bake.h"
 #include "estimation/frame_estimator.h"
 #include "render/compositor.h"
-#include "relight/env_lights.h"
+#include "lightfit/env_lights.h"
 #include "relight/env_relight.h"
-#include "relight/irradiance_volume.h"
-#include "relight/object_bounce.h"
-#include "relight/object_shadows.h"
+#include "sh/irradiance_volume.h"
+#include "composite/object_bounce.h"
+#include "composite/object_shadows.h"
 #include "scene/raycaster.h"
 #include "scene/scene.h"
 
@@ -27,7 +27,7 @@ namespace daylit::render {
 struct FrameRendererOptions {
   CompositorOptions compositor;
   // 0: the objects' light besides the sun is the irradiance volume. N > 0: N directional lights
-  // and an ambient term fitted to the relit env map (relight::EnvLights), each casting shadows
+  // and an ambient term fitted to the relit env map (lightfit::EnvLights), each casting shadows
   // (daylit render/replay --lighting lights:N).
   int lights = 0;
 };
@@ -50,9 +50,9 @@ class FrameRenderer {
 
   // The frame linearised in radiance units, as Render starts from (for comparisons).
   void Linearize(const capture::Frame& frame, std::vector<float>* linear) const;
-  const relight::ObjectShadows& shadows() const { return shadows_; }
+  const composite::ObjectShadows& shadows() const { return shadows_; }
   // With --lighting lights:N, the lights (null otherwise).
-  const relight::EnvLights* env_lights() const { return env_lights_.get(); }
+  const lightfit::EnvLights* env_lights() const { return env_lights_.get(); }
   int width() const { return compositor_.width(); }
   int height() const { return compositor_.height(); }
 
@@ -61,15 +61,15 @@ class FrameRenderer {
   const scene::RayCaster& caster_;
   scene::SceneModel objects_model_;  // before objects_, which keeps a reference to it
   scene::RayCaster objects_;
-  relight::ObjectShadows shadows_;
-  relight::ObjectBounce bounce_;
+  composite::ObjectShadows shadows_;
+  composite::ObjectBounce bounce_;
   relight::EnvRelighter relighter_;
-  std::unique_ptr<relight::IrradianceVolume> volume_;
+  std::unique_ptr<sh::IrradianceVolume> volume_;
   Compositor compositor_;
   capture::Linearizer linearizer_;
   relight::EnvBasis basis_;
   std::array<std::vector<float>, 3> volume_parts_;  // the volume per unit E_sun, E_clear, E_overcast
-  std::unique_ptr<relight::EnvLights> env_lights_;  // --lighting lights:N
+  std::unique_ptr<lightfit::EnvLights> env_lights_;  // --lighting lights:N
 };
 
 }  // namespace daylit::render

@@ -60,7 +60,7 @@ ImageRelightGl::ImageRelightGl(int width, int height)
   glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target_.get(), 0);
   const bool complete = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  if (!complete || glGetError() != GL_NO_ERROR) ThrowInputError("OpenGL: setting up image relighting failed");
+  if (!complete || glGetError() != GL_NO_ERROR) ThrowSystemError("OpenGL: setting up image relighting failed");
   glUseProgram(program_.id());
   const char* names[] = {"frame", "now_sun", "now_clear", "now_overcast", "new_sun", "new_clear", "new_overcast"};
   for (int i = 0; i < 7; ++i) glUniform1i(program_.Uniform(names[i]), i);
@@ -109,7 +109,7 @@ relight::RelightStats ImageRelightGl::Apply(const relight::RatioTerms& terms, co
   glReadPixels(0, 0, width_, height_, GL_RGBA, GL_FLOAT, readback_.data());
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   glActiveTexture(GL_TEXTURE0);
-  if (glGetError() != GL_NO_ERROR) ThrowInputError("OpenGL: image relighting failed");
+  if (glGetError() != GL_NO_ERROR) ThrowSystemError("OpenGL: image relighting failed");
   relight::RelightStats stats;
   stats.model_pixels = model_pixels_;
   const size_t n = static_cast<size_t>(width_) * static_cast<size_t>(height_);

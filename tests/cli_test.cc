@@ -20,8 +20,8 @@
 #include "capture/video_decoder.h"
 #include "base/atomic_file.h"
 #include "base/csv.h"
-#include "relight/exact_irradiance.h"
-#include "relight/lights.h"
+#include "sh/exact_irradiance.h"
+#include "lightfit/lights.h"
 #include "scene/hdr_image.h"
 #include "scene/scene.h"
 #include "scene/scene_test_util.h"
@@ -239,20 +239,20 @@ TEST(CliTest, LightsWritesTheLightsTheirErrorsAndTheAutomaticN) {
   // The file's lights, evaluated as its format says (E(n) = ambient + Σ irradiance·max(0, n·d)),
   // give the error the CSV reports against the exact irradiance.
   const scene::HdrImage map = scene::ReadHdrImage(kProbe);
-  const std::vector<glm::vec3> normals = relight::IcosahedronNormals(5);
-  const std::vector<glm::dvec3> truth = relight::ExactIrradiance(map, normals);
+  const std::vector<glm::vec3> normals = sh::IcosahedronNormals(5);
+  const std::vector<glm::dvec3> truth = sh::ExactIrradiance(map, normals);
   std::map<std::string, double> mean_of;
   for (const auto& row : errors.rows) mean_of[row[0] + "_" + row[1]] = std::stod(row[2]);
   for (const char* name : {"mediancut_1", "mediancut_8", "io_1", "io_4"}) {
     ASSERT_TRUE(mean_of.count(name)) << name;
     const nlohmann::json json = nlohmann::json::parse(ReadTextFile(out / (std::string("lights_") + name + ".json")));
-    relight::LightSet set;
+    lightfit::LightSet set;
     set.ambient = glm::vec3(json["ambient"][0], json["ambient"][1], json["ambient"][2]);
     for (const auto& l : json["lights"]) {
       set.lights.push_back({glm::vec3(l["direction"][0], l["direction"][1], l["direction"][2]),
                             glm::vec3(l["irradiance"][0], l["irradiance"][1], l["irradiance"][2])});
     }
-    EXPECT_NEAR(relight::RelativeError(truth, set.Irradiance(normals)).mean, mean_of[name], 1e-5) << name;
+    EXPECT_NEAR(lightfit::RelativeError(truth, set.Irradiance(normals)).mean, mean_of[name], 1e-5) << name;
   }
   EXPECT_TRUE(mean_of.count("sh_9"));
   EXPECT_LT(mean_of["io_4"], 0.05);
@@ -514,7 +514,7 @@ TEST(CliTest, ReplayAndRenderWithoutOpenGlSayWhy) {
   for (const std::string& args : {"replay " + kRecording + " --frames 5 --out " + (dir / "r.mp4").string(),
                                   "render " + kRecording + " --frame 5 --out " + (dir / "f.png").string()}) {
     const CliRun run = Daylit(args, no_egl);
-    EXPECT_EQ(run.exit_code, 2) << args;
+    EXPECT_EQ(run.exit_code, 1) << args;  // the machine's, not bad input (2) nor a bug (3)
     EXPECT_NE(run.err.find("OpenGL: no EGL display"), std::string::npos) << run.err;
   }
   // No display for --window: said so.

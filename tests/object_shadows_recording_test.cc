@@ -2,7 +2,7 @@
 // tracer: groundtruth/with_objects ÷ without_objects is the true change per pixel. The light is
 // groundtruth.csv's and the frame the noise-free one, so this measures the shadow model alone,
 // not the estimation or the camera's noise.
-#include "relight/object_shadows.h"
+#include "composite/object_shadows.h"
 
 #include <gtest/gtest.h>
 
@@ -39,7 +39,7 @@ TEST(ObjectShadowsRecordingTest, ShadowsAndSkyLossMatchThePathTracer) {
   const scene::RayCaster real(scene.model);
   const scene::SceneModel objects_model = scene::ObjectsModel(scene.objects);
   const scene::RayCaster objects(objects_model);
-  ObjectShadows shadows(scene, c.bake, real, objects);
+  composite::ObjectShadows shadows(scene, c.bake, real, objects);
   EnvRelighter relighter(c.bake, glm::vec3(scene.envmap->position), real);
   EnvBasis basis;
   std::printf("sky loss on %zu pixels\n", shadows.SkyLossPixels());

@@ -18,7 +18,7 @@
 #include "base/log.h"
 #include "estimation/frame_estimator.h"
 #include "relight/env_relight.h"
-#include "relight/irradiance_volume.h"
+#include "sh/irradiance_volume.h"
 #include "scene/latlong.h"
 #include "scene/scene.h"
 
@@ -34,7 +34,7 @@ TEST(VolumeRecordingTest, CourtyardVolumeMatchesBruteForceIrradiance) {
   relighter.SetSun(fit.sun_dir);
   std::vector<glm::vec3> env;
   relighter.Relight(fit.fit.light, fit.fit.overcast_share, &env);
-  relight::IrradianceVolume volume(baked.gather, relight::ProbesInsideModel(baked.gather, caster));
+  sh::IrradianceVolume volume(baked.gather, sh::ProbesInsideModel(baked.gather, caster));
   volume.Update(env);
   const glm::vec3 capture(scene.envmap->position);
   const int w = baked.env.width, h = baked.env.height;

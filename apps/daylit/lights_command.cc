@@ -2,9 +2,7 @@
 // optimization) and by SH9, with seed 002's error measure, the automatic N and the error plot
 // (docs/relight.md).
 #include <algorithm>
-#include <chrono>
 #include <filesystem>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,22 +16,18 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "base/progress.h"
-#include "relight/exact_irradiance.h"
-#include "relight/light_fit.h"
-#include "relight/lights.h"
-#include "relight/probe.h"
-#include "relight/sh9.h"
+#include "sh/exact_irradiance.h"
+#include "lightfit/light_fit.h"
+#include "lightfit/lights.h"
+#include "lightfit/probe.h"
+#include "lightfit/probe_approximations.h"
+#include "sh/sh9.h"
 #include "report/plot.h"
 
 namespace daylit::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-// The most lights each method takes: irradiance optimization's dense normal equations grow as
-// (5N)², median cut's regions are cheap.
-constexpr int kMaxIoLights = 128;
-constexpr int kMaxMedianCutLights = 1024;
 
 struct LightsOptions {
   std::string probe;
@@ -44,10 +38,11 @@ struct LightsOptions {
   bool no_ambient = false;
 };
 
+// One line of errors.csv and of the plot.
 struct Row {
-  std::string method;
+  lightfit::Method method;
   int n = 0;
-  relight::ApproximationError error;
+  lightfit::ApproximationError error;
 };
 
 std::vector<std::string> SplitList(const std::string& list) {
@@ -92,88 +87,6 @@ std::vector<int> ParseCounts(const std::string& list, int max) {
 }
 
 
-class Approximator {
- public:
-  Approximator(const scene::HdrImage& map, fs::path out, relight::LightFitOptions fit)
-      : map_(map), out_(std::move(out)), fit_(fit) {
-    normals_ = relight::IcosahedronNormals(5);
-    truth_ = relight::ExactIrradiance(map_, normals_);
-  }
-
-  // Fits (or looks up) `method` with n lights, writes lights_<method>_<n>.json, returns the row.
-  const Row& Lights(const std::string& method, int n) {
-    const auto key = std::make_pair(method, n);
-    if (const auto found = rows_.find(key); found != rows_.end()) return found->second;
-    const auto start = std::chrono::steady_clock::now();
-    relight::LightSet set;
-    std::string detail;
-    if (method == "io") {
-      const relight::LightFitResult fit = relight::IrradianceOptimization(map_, n, fit_);
-      set = fit.lights;
-      if (!fit.converged) Log().warn("io, {} lights: not converged: {}", n, fit.termination);
-      detail = fmt::format(", {} iterations", fit.iterations);
-    } else {
-      set = relight::MedianCutLights(map_, n);
-    }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    WriteFileAtomically(out_ / fmt::format("lights_{}_{}.json", method, n), relight::LightSetJson(set));
-    Row row{method, n, relight::RelativeError(truth_, set.Irradiance(normals_))};
-    Log().debug("{}, {} lights: mean {:.2f}%, max {:.2f}% ({:.3f} s{})", method, n, 100 * row.error.mean,
-                100 * row.error.max, seconds, detail);
-    return rows_.emplace(key, row).first->second;
-  }
-
-  // SH9 in both measures; writes sh9.json.
-  Row Sh9() {
-    const relight::ShRgb9 sh = relight::ProjectLatLong(map_.rgb.data(), map_.width, map_.height);
-    std::vector<glm::dvec3> e(normals_.size());
-    for (size_t i = 0; i < normals_.size(); ++i) e[i] = sh.Irradiance(glm::dvec3(normals_[i]));
-    const relight::ApproximationError per_normal = relight::RelativeError(truth_, e);
-    sh9_to_max_ = relight::RelativeToMaxError(truth_, e);
-    nlohmann::json coefficients = nlohmann::json::array();
-    for (const glm::dvec3& c : sh.coefficients) coefficients.push_back({c.x, c.y, c.z});
-    const nlohmann::json json = {
-        {"radiance_coefficients", coefficients},
-        {"basis", "real SH, l <= 2, order 00 1-1 10 11 2-2 2-1 20 21 22 (relight/sh9.h); E(n) = sum A_l L_lm Y_lm(n)"},
-        {"error_per_normal", {{"mean", per_normal.mean}, {"max", per_normal.max}}},
-        {"error_relative_to_max", {{"mean", sh9_to_max_.mean}, {"max", sh9_to_max_.max}}}};
-    WriteFileAtomically(out_ / "sh9.json", json.dump(2) + "\n");
-    return {"sh", 9, per_normal};
-  }
-
-  // The smallest n ≤ max whose mean error is below `threshold`: doubling, then bisection (the
-  // error falls with n, nearly monotonically). Empty when even `max` lights do not reach it.
-  std::optional<int> Automatic(const std::string& method, double threshold, int max) {
-    int below = 1;
-    while (Lights(method, below).error.mean >= threshold) {
-      if (below == max) return std::nullopt;
-      below = std::min(2 * below, max);
-    }
-    int above = below / 2;  // its error is ≥ threshold (or it is 0)
-    while (below - above > 1) {
-      const int middle = (above + below) / 2;
-      (Lights(method, middle).error.mean < threshold ? below : above) = middle;
-    }
-    return below;
-  }
-
-  const std::map<std::pair<std::string, int>, Row>& rows() const { return rows_; }
-  const relight::ApproximationError& sh9_to_max() const { return sh9_to_max_; }
-
- private:
-  const scene::HdrImage& map_;
-  fs::path out_;
-  relight::LightFitOptions fit_;
-  std::vector<glm::vec3> normals_;
-  std::vector<glm::dvec3> truth_;
-  std::map<std::pair<std::string, int>, Row> rows_;
-  relight::ApproximationError sh9_to_max_;
-};
-
-const char* MethodName(const std::string& method) {
-  return method == "io" ? "irradiance optimization" : method == "mediancut" ? "median cut" : "SH9";
-}
-
 // Seed 002's Fig. 4: mean and max error against the number of lights, log-log.
 void WritePlot(const fs::path& path, const std::string& probe, const std::vector<Row>& rows, std::optional<double> threshold) {
   std::vector<cv::Mat> panels;
@@ -185,10 +98,11 @@ void WritePlot(const fs::path& path, const std::string& probe, const std::vector
     report::LinePlot plot(options);
     int color = 0;
     double x_lo = 1e9, x_hi = 0.0;
-    for (const std::string method : {"mediancut", "io", "sh"}) {
-      report::Series series{MethodName(method), {}, {}, report::SeriesColor(color++)};
-      series.markers_only = method == "sh";
-      if (method == "sh") series.name = "SH9 (9 coefficients)";
+    for (const lightfit::Method method :
+         {lightfit::Method::kMedianCut, lightfit::Method::kIrradianceOptimization, lightfit::Method::kSh9}) {
+      report::Series series{lightfit::MethodName(method), {}, {}, report::SeriesColor(color++)};
+      series.markers_only = method == lightfit::Method::kSh9;
+      if (method == lightfit::Method::kSh9) series.name = "SH9 (9 coefficients)";
       for (const Row& r : rows) {
         if (r.method != method) continue;
         series.x.push_back(r.n), series.y.push_back(100 * (max ? r.error.max : r.error.mean));
@@ -207,91 +121,121 @@ void WritePlot(const fs::path& path, const std::string& probe, const std::vector
   report::WritePng(path, panels);
 }
 
-void RunLights(const LightsOptions& o) {
-  const std::vector<std::string> methods = SplitList(o.methods);
-  if (methods.empty()) ThrowInputError("--method: no method given (mediancut, io, sh)");
-  for (const std::string& m : methods) {
-    if (m != "mediancut" && m != "io" && m != "sh") ThrowInputError("--method: '{}' is not one of mediancut, io, sh", m);
+std::vector<lightfit::Method> ParseMethods(const std::string& list) {
+  std::vector<lightfit::Method> methods;
+  for (const std::string& key : SplitList(list)) {
+    const std::optional<lightfit::Method> m = lightfit::ParseMethod(key);
+    if (!m) ThrowInputError("--method: '{}' is not one of mediancut, io, sh", key);
+    methods.push_back(*m);
   }
-  const bool io = std::find(methods.begin(), methods.end(), "io") != methods.end();
-  const std::vector<int> counts = ParseCounts(o.n, io ? kMaxIoLights : kMaxMedianCutLights);
+  if (methods.empty()) ThrowInputError("--method: no method given (mediancut, io, sh)");
+  return methods;
+}
+
+// The table's fits (small n first: the cheap ones show progress early; io's 64 and 128 take tens
+// of seconds), then the automatic N of each method under the threshold (automatic.json).
+void Approximate(const LightsOptions& o, const std::vector<lightfit::Method>& methods, const std::vector<int>& counts,
+                 lightfit::ProbeApproximations* table) {
+  size_t jobs = 0;
+  for (const lightfit::Method m : methods) jobs += m == lightfit::Method::kSh9 ? 1 : counts.size();
+  {
+    Progress progress("lights", jobs);
+    for (const lightfit::Method m : methods) {
+      for (const int n : m == lightfit::Method::kSh9 ? std::vector<int>{9} : counts) {
+        progress.SetSuffix(fmt::format("{} {}", lightfit::MethodKey(m), n));
+        if (m == lightfit::Method::kSh9) {
+          table->Sh9();
+        } else {
+          table->Lights(m, n);
+        }
+        progress.Advance();
+      }
+    }
+  }
+  if (!o.threshold) return;
+  nlohmann::json automatic = {{"threshold", *o.threshold}};
+  for (const lightfit::Method m : methods) {
+    if (m == lightfit::Method::kSh9) continue;
+    const char* name = lightfit::MethodName(m);
+    const std::optional<int> n = table->AutomaticN(m, *o.threshold);
+    if (!n) {
+      Log().warn("{}: no number of lights up to {} reaches a mean error below {:g}%", name, lightfit::MaxLights(m),
+                 100 * *o.threshold);
+      automatic[lightfit::MethodKey(m)] = nullptr;
+      continue;
+    }
+    const lightfit::LightsApproximation& row = table->Lights(m, *n);
+    automatic[lightfit::MethodKey(m)] = {{"n", *n}, {"mean_error", row.error.mean}, {"max_error", row.error.max},
+                                         {"lights", fmt::format("lights_{}_{}.json", lightfit::MethodKey(m), *n)}};
+    fmt::print("{}: {} lights reach a mean error of {:.2f}% (below {:g}%)\n", name, *n, 100 * row.error.mean,
+               100 * *o.threshold);
+  }
+  WriteFileAtomically(fs::path(o.out) / "automatic.json", automatic.dump(2) + "\n");
+}
+
+// lights_<method>_<n>.json for every fit and sh9.json; the rows of errors.csv in method then n order.
+std::vector<Row> WriteFits(const fs::path& out, const std::vector<lightfit::Method>& methods,
+                           lightfit::ProbeApproximations* table) {
+  std::vector<Row> rows;
+  for (const lightfit::Method m : methods) {
+    if (m == lightfit::Method::kSh9) {
+      const lightfit::Sh9Approximation& sh9 = table->Sh9();
+      nlohmann::json coefficients = nlohmann::json::array();
+      for (const glm::dvec3& c : sh9.radiance.coefficients) coefficients.push_back({c.x, c.y, c.z});
+      const nlohmann::json json = {
+          {"radiance_coefficients", coefficients},
+          {"basis", "real SH, l <= 2, order 00 1-1 10 11 2-2 2-1 20 21 22 (sh/sh9.h); E(n) = sum A_l L_lm Y_lm(n)"},
+          {"error_per_normal", {{"mean", sh9.error.mean}, {"max", sh9.error.max}}},
+          {"error_relative_to_max", {{"mean", sh9.error_to_max.mean}, {"max", sh9.error_to_max.max}}}};
+      WriteFileAtomically(out / "sh9.json", json.dump(2) + "\n");
+      rows.push_back({m, 9, sh9.error});
+      continue;
+    }
+    for (const lightfit::LightsApproximation* fit : table->Fitted(m)) {
+      WriteFileAtomically(out / fmt::format("lights_{}_{}.json", lightfit::MethodKey(m), fit->n),
+                          lightfit::LightSetJson(fit->lights));
+      if (!fit->converged) Log().warn("io, {} lights: not converged: {}", fit->n, fit->termination);
+      Log().debug("{}, {} lights: mean {:.2f}%, max {:.2f}% ({:.3f} s)", lightfit::MethodKey(m), fit->n,
+                  100 * fit->error.mean, 100 * fit->error.max, fit->seconds);
+      rows.push_back({m, fit->n, fit->error});
+    }
+  }
+  return rows;
+}
+
+void RunLights(const LightsOptions& o) {
+  const std::vector<lightfit::Method> methods = ParseMethods(o.methods);
+  const bool io = std::find(methods.begin(), methods.end(), lightfit::Method::kIrradianceOptimization) != methods.end();
+  const std::vector<int> counts =
+      ParseCounts(o.n, lightfit::MaxLights(io ? lightfit::Method::kIrradianceOptimization : lightfit::Method::kMedianCut));
   if (o.threshold && !(*o.threshold > 0.0 && *o.threshold < 1.0)) {
     ThrowInputError("--threshold: {} is not a mean relative error in (0, 1)", *o.threshold);
   }
-  relight::Probe probe = relight::LoadProbe(o.probe);
+  lightfit::Probe probe = lightfit::LoadProbe(o.probe);
   for (const std::string& w : probe.warnings) Log().warn("{}", w);
   Log().info("{}: {}x{} lat-long{}", o.probe, probe.map.width, probe.map.height,
              probe.converted_from_angular ? " (converted from an angular map)" : "");
   fs::create_directories(o.out);
-  relight::LightFitOptions fit;
+  lightfit::LightFitOptions fit;
   fit.ambient = !o.no_ambient;
-  Approximator approximator(probe.map, o.out, fit);
-
-  std::vector<Row> rows;
-  size_t jobs = 0;
-  for (const std::string& m : methods) jobs += m == "sh" ? 1 : counts.size();
-  {
-    Progress progress("lights", jobs);
-    for (const std::string& m : methods) {
-      if (m == "sh") {
-        rows.push_back(approximator.Sh9());
-        progress.Advance();
-        continue;
-      }
-      // Small n first: the cheap fits show progress early; io's 64 and 128 take tens of seconds.
-      for (const int n : counts) {
-        progress.SetSuffix(fmt::format("{} {}", m, n));
-        approximator.Lights(m, n);
-        progress.Advance();
-      }
-    }
-  }
-  nlohmann::json automatic = nlohmann::json::object();
-  if (o.threshold) {
-    automatic["threshold"] = *o.threshold;
-    for (const std::string& m : methods) {
-      if (m == "sh") continue;
-      const int max = m == "io" ? kMaxIoLights : kMaxMedianCutLights;
-      const std::optional<int> n = approximator.Automatic(m, *o.threshold, max);
-      if (!n) {
-        Log().warn("{}: no number of lights up to {} reaches a mean error below {:g}%", MethodName(m), max, 100 * *o.threshold);
-        automatic[m] = nullptr;
-        continue;
-      }
-      const Row& row = approximator.Lights(m, *n);
-      automatic[m] = {{"n", *n}, {"mean_error", row.error.mean}, {"max_error", row.error.max},
-                      {"lights", fmt::format("lights_{}_{}.json", m, *n)}};
-      fmt::print("{}: {} lights reach a mean error of {:.2f}% (below {:g}%)\n", MethodName(m), *n, 100 * row.error.mean,
-                 100 * *o.threshold);
-    }
-    WriteFileAtomically(fs::path(o.out) / "automatic.json", automatic.dump(2) + "\n");
-  }
-  // Every (method, n) computed, the automatic search's included, in method then n order.
-  std::vector<Row> all;
-  for (const std::string& m : methods) {
-    if (m == "sh") {
-      for (const Row& r : rows) {
-        if (r.method == "sh") all.push_back(r);
-      }
-      continue;
-    }
-    for (const auto& [key, row] : approximator.rows()) {
-      if (key.first == m) all.push_back(row);
-    }
-  }
+  lightfit::ProbeApproximations table(probe.map, fit);
+  Approximate(o, methods, counts, &table);
+  const std::vector<Row> rows = WriteFits(o.out, methods, &table);
   std::string csv = "method,n,mean_error,max_error\n";
-  for (const Row& r : all) csv += fmt::format("{},{},{:.6g},{:.6g}\n", r.method, r.n, r.error.mean, r.error.max);
-  WriteFileAtomically(fs::path(o.out) / "errors.csv", csv);
-  WritePlot(fs::path(o.out) / "errors.png", fs::path(o.probe).filename().string(), all, o.threshold);
-
-  fmt::print("{:<24} {:>6} {:>10} {:>10}   (per-normal relative irradiance error over {} normals)\n", "method", "n",
-             "mean", "max", all.empty() ? 0 : all.front().error.normals);
-  for (const Row& r : all) {
-    fmt::print("{:<24} {:>6} {:>9.2f}% {:>9.2f}%\n", MethodName(r.method), r.n, 100 * r.error.mean, 100 * r.error.max);
+  for (const Row& r : rows) {
+    csv += fmt::format("{},{},{:.6g},{:.6g}\n", lightfit::MethodKey(r.method), r.n, r.error.mean, r.error.max);
   }
-  if (std::find(methods.begin(), methods.end(), "sh") != methods.end()) {
+  WriteFileAtomically(fs::path(o.out) / "errors.csv", csv);
+  WritePlot(fs::path(o.out) / "errors.png", fs::path(o.probe).filename().string(), rows, o.threshold);
+  fmt::print("{:<24} {:>6} {:>10} {:>10}   (per-normal relative irradiance error over {} normals)\n", "method", "n",
+             "mean", "max", rows.empty() ? 0 : rows.front().error.normals);
+  for (const Row& r : rows) {
+    fmt::print("{:<24} {:>6} {:>9.2f}% {:>9.2f}%\n", lightfit::MethodName(r.method), r.n, 100 * r.error.mean,
+               100 * r.error.max);
+  }
+  if (std::find(methods.begin(), methods.end(), lightfit::Method::kSh9) != methods.end()) {
     fmt::print("SH9 relative to the maximum irradiance (Ramamoorthi & Hanrahan's measure): mean {:.2f}%, max {:.2f}%\n",
-               100 * approximator.sh9_to_max().mean, 100 * approximator.sh9_to_max().max);
+               100 * table.Sh9().error_to_max.mean, 100 * table.Sh9().error_to_max.max);
   }
   Log().info("wrote {}/errors.csv, errors.png and the lights", o.out);
 }

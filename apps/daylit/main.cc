@@ -40,6 +40,9 @@ int main(int argc, char** argv) {
   } catch (const daylit::InputError& e) {
     daylit::Log().error("{}", e.what());
     return daylit::kInputErrorExitCode;
+  } catch (const daylit::SystemError& e) {
+    daylit::Log().error("{}", e.what());
+    return 1;
   } catch (const daylit::InvariantError& e) {
     daylit::Log().critical("internal error (a bug in daylit, not your input): {}", e.what());
     return daylit::kInternalErrorExitCode;

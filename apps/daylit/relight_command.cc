@@ -153,7 +153,7 @@ void RunRelight(const RelightOptions& o) {
   std::unique_ptr<render::HeadlessGlContext> gl;
   if (o.objects || o.gpu) {
     gl = render::HeadlessGlContext::Create(&why);
-    if (gl == nullptr) ThrowInputError("OpenGL: {}", why);
+    if (gl == nullptr) ThrowSystemError("OpenGL: {}", why);
   }
   std::optional<pipeline::VideoOutput> video;
   if (!single) video.emplace(out, scene);

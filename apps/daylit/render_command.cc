@@ -42,7 +42,7 @@ void RunRender(const RenderOptions& o) {
   options.lights = render::ParseLighting(o.lighting, "--lighting");
   std::string why;
   const auto gl = render::HeadlessGlContext::Create(&why);
-  if (gl == nullptr) ThrowInputError("OpenGL: {}", why);
+  if (gl == nullptr) ThrowSystemError("OpenGL: {}", why);
   bool loaded = false;
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, bake::CacheDir(scene, o.cache), &loaded);
   const scene::RayCaster caster(scene.model);
@@ -56,7 +56,7 @@ void RunRender(const RenderOptions& o) {
   } else {
     report::WritePng(out, {capture::EncodeToBgr8(composite.data(), w, h, fit.frame.exposure, &scene.response)});
   }
-  if (const relight::EnvLights* lights = renderer.env_lights()) {
+  if (const lightfit::EnvLights* lights = renderer.env_lights()) {
     Log().info("the objects lit by the sun and {} lights fitted to the relit env map ({:.1f}% off its irradiance)",
                lights->count(), 100 * lights->error());
   }

@@ -21,7 +21,7 @@
 #include "pipeline/stages.h"
 #include "pipeline/video_output.h"
 #include "pipeline/window_sink.h"
-#include "relight/time_slider.h"
+#include "render/time_slider.h"
 #include "render/frame_renderer.h"
 #include "render/gl_context.h"
 #include "render/gl_window.h"
@@ -56,9 +56,10 @@ void WriteReplayReport(const scene::Scene& scene, const pipeline::PipelineRun& r
   report.Say(fmt::format("  per frame (median): estimate {:.1f} ms, relight + render {:.1f} ms (encoding on its own thread)",
                          run.median_estimate_ms, run.median_stage_ms));
   if (run.undecodable > 0) report.Say(fmt::format("  {} frames could not be decoded (shown as the frame before)", run.undecodable));
-  if (const relight::EnvLights* lights = renderer.env_lights()) {
+  if (const lightfit::EnvLights* lights = renderer.env_lights()) {
     report.Say(fmt::format("  the objects lit by the sun and {} lights, their directions fitted {} times (sun moves and "
-                           "large changes of the light)", lights->count(), lights->generation()));
+                           "large changes of the light; {} stopped at the iteration limit)",
+                           lights->count(), lights->generation(), lights->unconverged_fits()));
   }
   evaluation::ReportLighting(scene, run.frames, dir / "estimates.csv", dir / "lighting.png", &report);
   fidelity.Finish(dir, &report);
@@ -79,8 +80,8 @@ void RunReplay(const ReplayOptions& o) {
   if (!o.relight_at.empty() && !o.window) ThrowInputError("--relight-at: needs --window (daylit relight writes a relit video)");
   render::FrameRendererOptions render_options;
   render_options.lights = render::ParseLighting(o.lighting, "--lighting");
-  relight::TimeSlider slider(scene.location.longitude_deg);
-  if (!o.relight_at.empty()) slider.SetUtcMinutes(relight::ParseUtcTimeOfDay(o.relight_at, "--relight-at"));
+  render::TimeSlider slider(scene.location.longitude_deg);
+  if (!o.relight_at.empty()) slider.SetUtcMinutes(render::ParseUtcTimeOfDay(o.relight_at, "--relight-at"));
   // Everything that can fail without the bake fails before it: the frames, GL, the output.
   std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
   // In a window, a recording plays at its own pace; a camera paces itself.
@@ -95,7 +96,7 @@ void RunReplay(const ReplayOptions& o) {
     if (window == nullptr) ThrowInputError("--window: {}", why);
   } else {
     gl = render::HeadlessGlContext::Create(&why);
-    if (gl == nullptr) ThrowInputError("OpenGL: {}", why);
+    if (gl == nullptr) ThrowSystemError("OpenGL: {}", why);
     Log().info("rendering with {} ({})", gl->renderer(), gl->platform());
   }
   bool loaded = false;
