@@ -143,7 +143,7 @@ void BM_FitEnvLights(benchmark::State& state) {
   scene::ObjectsModel(c.scene.objects).Bounds(&lo, &hi);
   lightfit::EnvLights lights(static_cast<int>(state.range(0)), *c.caster, 0.5f * (lo + hi), glm::vec3(c.scene.envmap->position),
                             c.bake.env.width, c.bake.env.height);
-  const relight::LightParts parts = relight::SplitLight(c.fit.fit.light, c.fit.fit.overcast_share);
+  const estimation::LightParts parts = estimation::SplitLight(c.fit.fit.light, c.fit.fit.overcast_share);
   for (auto _ : state) {
     lights.SetBasis(basis);
     benchmark::DoNotOptimize(lights.Update(parts));
@@ -167,7 +167,7 @@ BENCHMARK(BM_RendererSetUp)->Unit(benchmark::kMillisecond)->UseRealTime()->Itera
 struct Relight720 {
   relight::RatioTerms terms;
   std::vector<float> frame;
-  relight::LightParts now, next;
+  estimation::LightParts now, next;
 
   static const Relight720& Get() {
     static const Relight720 built = [] {
@@ -195,7 +195,7 @@ struct Relight720 {
           for (size_t k = 0; k < 3; ++k) r.frame[3 * p + k] = linear[3 * q + k];
         }
       }
-      r.now = relight::SplitLight(c.fit.fit.light, c.fit.fit.overcast_share);
+      r.now = estimation::SplitLight(c.fit.fit.light, c.fit.fit.overcast_share);
       r.next = r.now;
       return r;
     }();

@@ -210,7 +210,7 @@ void ObjectShadows::Apply(const estimation::SunSky& light, double overcast_share
   // pixel then keeps the share (B − ΔB)/B of its own value, noise included.
   if (affected_.empty()) return;
   if (!loss_ready_) PrepareLoss();
-  const relight::LightParts e = relight::SplitLight(light, overcast_share);
+  const estimation::LightParts e = estimation::SplitLight(light, overcast_share);
   const int w = gbuffer_.width, h = gbuffer_.height;
   const size_t row_floats = 3 * static_cast<size_t>(w);
   const int first_row = static_cast<int>(loss_.front().pixel / static_cast<uint32_t>(w));
@@ -254,7 +254,7 @@ void ObjectShadows::Apply(const estimation::SunSky& light, double overcast_share
           }
           b /= static_cast<float>(std::max(n, 1));
         }
-        const glm::vec3 lost = e.sun * a.sun + e.clear * a.clear + e.overcast * a.overcast;
+        const glm::vec3 lost = estimation::Irradiance(e, a.sun, a.clear, a.overcast);
         float* p = rgb + 3 * static_cast<size_t>(a.pixel);
         for (int c = 0; c < 3; ++c) p[c] *= b[c] > 0.0f ? std::clamp(1.0f - lost[c] / b[c], 0.0f, 1.0f) : 1.0f;
       }

@@ -1,12 +1,17 @@
 // The one radiometric model of daylit (docs/design.md), per colour channel, for a Lambertian
-// point x with albedo ρ and normal n:
+// point x with albedo ρ:
 //
-//   L(x) = ρ/π · ( E_sun · s(x) · max(0, n·l) + E_sky · V(x) )
+//   L(x) = ρ/π · E(x),   E(x) = E_sun·T_sun(x) + E_clear·T_clear(x) + E_overcast·T_overcast(x)
 //
-// E_sun: direct normal irradiance of the sun (DNI); E_sky: diffuse horizontal irradiance of the
-// sky (DHI); l: unit vector to the sun; s ∈ [0, 1]: sun visibility; V ∈ [0, 1]: cosine-weighted
-// visible-sky fraction. Radiance in the units of E over steradians. For a fixed sun direction
-// L is linear in (E_sun, E_sky), which is what makes the per-frame fit a small linear problem.
+// E_sun: direct normal irradiance of the sun (DNI); E_clear + E_overcast = E_sky, the diffuse
+// horizontal irradiance of the sky (DHI), split into a part shaped like the captured clear sky
+// and a uniform overcast part. T: the point's transfer, its irradiance per unit of each part
+// (direct and reflected; estimation/transfer.h computes it). Without interreflection and with a
+// uniform sky, T_sun = s·max(0, n·l) (s the sun's visibility) and T_clear = T_overcast = V (the
+// cosine-weighted visible-sky fraction), which is seed 001's model. Radiance is in the units of
+// E over steradians. For a fixed sun E is linear in the parts: the per-frame fit is a small
+// linear problem, and every stage (the relit env map, the relit image, the objects' shadows)
+// combines per-part terms with these weights.
 #pragma once
 
 #include <glm/glm.hpp>
@@ -19,23 +24,28 @@ struct SunSky {
   glm::dvec3 sky_rgb{0.0};  // E_sky, DHI
 };
 
-// The geometric factors of a point under a sun direction.
-struct ShadingTerms {
-  double sun = 0.0;  // s · max(0, n·l): fraction of DNI that reaches the point, per unit
-  double sky = 0.0;  // V: fraction of DHI that reaches the point
+// The three parts of the light, RGB, ≥ 0: E_sun, E_clear = (1 − o)·E_sky, E_overcast = o·E_sky.
+struct LightParts {
+  glm::vec3 sun{0.0f}, clear{0.0f}, overcast{0.0f};
+};
+// The parts of `light` with the overcast share o = E_overcast / E_sky (clamped to [0, 1]).
+LightParts SplitLight(const SunSky& light, double overcast_share);
+
+// Irradiance at a point per unit of each part, RGB (reflected light takes the colour of the
+// surfaces it comes from).
+struct Transfer {
+  glm::vec3 sun{0.0f};       // per unit DNI
+  glm::vec3 clear{0.0f};     // per unit DHI of the captured sky's distribution (= overcast without one)
+  glm::vec3 overcast{0.0f};  // per unit DHI of a uniform sky
 };
 
-// s · max(0, n·l) and V for a point with unit normal `n`, unit sun vector `l`.
-ShadingTerms TermsOf(const glm::dvec3& n, const glm::dvec3& l, double sun_visibility,
-                     double sky_visibility);
-
-// Irradiance E(x) = E_sun·s·max(0,n·l) + E_sky·V, per channel.
-glm::dvec3 Irradiance(const ShadingTerms& terms, const SunSky& light);
-
-// Radiance L(x) = ρ/π · E(x), per channel.
-glm::dvec3 Radiance(const glm::dvec3& albedo, const ShadingTerms& terms, const SunSky& light);
-
-// Albedo by inverse rendering, ρ = π·L / E; 0 where E is 0.
-glm::dvec3 AlbedoOf(const glm::dvec3& radiance, const glm::dvec3& irradiance);
+// E = E_sun·T_sun + E_clear·T_clear + E_overcast·T_overcast, per channel.
+inline glm::vec3 Irradiance(const LightParts& light, const glm::vec3& t_sun, const glm::vec3& t_clear,
+                            const glm::vec3& t_overcast) {
+  return light.sun * t_sun + light.clear * t_clear + light.overcast * t_overcast;
+}
+inline glm::vec3 Irradiance(const LightParts& light, const Transfer& t) {
+  return Irradiance(light, t.sun, t.clear, t.overcast);
+}
 
 }  // namespace daylit::estimation

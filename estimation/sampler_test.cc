@@ -43,7 +43,9 @@ struct WallScene {
     for (size_t i = 0; i < g.surface.size(); ++i) {
       if (g.surface[i] == bake::kNoSurface) continue;
       const float a = sampler.sunlit()[i] ? std::max(0.0f, glm::dot(g.normal[i], sun)) : 0.0f;
-      const glm::dvec3 l = exposure * Radiance(glm::dvec3(g.albedo[i]), ShadingTerms{a, g.sky_visibility[i]}, light);
+      // Seed 001's model: a uniform sky without interreflection (lighting_model.h).
+      const Transfer t{glm::vec3(a), glm::vec3(g.sky_visibility[i]), glm::vec3(g.sky_visibility[i])};
+      const glm::dvec3 l = exposure * glm::dvec3(g.albedo[i] * glm::one_over_pi<float>() * Irradiance(SplitLight(light, 0.0), t));
       frame.at<cv::Vec3f>(static_cast<int>(i / g.width), static_cast<int>(i % g.width)) =
           cv::Vec3f(static_cast<float>(l.x), static_cast<float>(l.y), static_cast<float>(l.z));
     }

@@ -34,6 +34,7 @@
 
 #include "bake/bake.h"
 #include "bake/capture_light.h"
+#include "estimation/lighting_model.h"
 #include "scene/raycaster.h"
 
 namespace daylit::estimation {
@@ -61,13 +62,7 @@ struct TransferPoints {
   static TransferPoints Env(const bake::EnvMapMaps& env);      // the env map's texels
 };
 
-// Irradiance at a point per unit DNI (sun) and per unit DHI of each sky, RGB (reflected light
-// takes the colour of the surfaces it comes from).
-struct Transfer {
-  glm::vec3 sun{0.0f};
-  glm::vec3 clear{0.0f};     // sky in the captured sky's distribution (= overcast without one)
-  glm::vec3 overcast{0.0f};  // uniform sky
-};
+// estimation::Transfer (lighting_model.h): irradiance per unit of each part of the light.
 
 class LightTransfer {
  public:

@@ -65,7 +65,7 @@ void EnvLights::SetBasis(const relight::EnvBasis& basis) {
   stale_ = true;
 }
 
-void EnvLights::FitDirections(const relight::LightParts& parts) {
+void EnvLights::FitDirections(const estimation::LightParts& parts) {
   // Irradiance Optimization of the map under this light (all parts alike when there is none).
   std::array<glm::vec3, 3> e = {parts.sun, parts.clear, parts.overcast};
   if (glm::length(e[0]) + glm::length(e[1]) + glm::length(e[2]) <= 0.0f) e.fill(glm::vec3(1.0f));
@@ -119,7 +119,7 @@ void EnvLights::FitDirections(const relight::LightParts& parts) {
   ++generation_;
 }
 
-LightSet EnvLights::Combine(const relight::LightParts& parts) const {
+LightSet EnvLights::Combine(const estimation::LightParts& parts) const {
   LightSet set;
   set.lights.resize(directions_.size());
   const glm::vec3 e[3] = {parts.sun, parts.clear, parts.overcast};
@@ -133,7 +133,7 @@ LightSet EnvLights::Combine(const relight::LightParts& parts) const {
   return set;
 }
 
-double EnvLights::ErrorOf(const LightSet& lights, const relight::LightParts& parts) const {
+double EnvLights::ErrorOf(const LightSet& lights, const estimation::LightParts& parts) const {
   std::vector<glm::dvec3> truth(normals_.size(), glm::dvec3(0.0));
   const glm::dvec3 e[3] = {glm::dvec3(parts.sun), glm::dvec3(parts.clear), glm::dvec3(parts.overcast)};
   for (size_t k = 0; k < 3; ++k) {
@@ -142,7 +142,7 @@ double EnvLights::ErrorOf(const LightSet& lights, const relight::LightParts& par
   return RelativeError(truth, lights.Irradiance(normals_)).mean;
 }
 
-const LightSet& EnvLights::Update(const relight::LightParts& parts) {
+const LightSet& EnvLights::Update(const estimation::LightParts& parts) {
   if (!stale_) {
     current_ = Combine(parts);
     error_ = ErrorOf(current_, parts);

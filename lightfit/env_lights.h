@@ -52,7 +52,7 @@ class EnvLights {
 
   // This frame's lights under `parts`: each part's irradiances weighted by its light (clamped at
   // 0), the directions fitted again first when needed.
-  const LightSet& Update(const relight::LightParts& parts);
+  const LightSet& Update(const estimation::LightParts& parts);
 
   int count() const { return n_; }
   // Per light: 1 when it stands for light the real model reflects (only the objects shadow it).
@@ -65,9 +65,9 @@ class EnvLights {
   double error() const { return error_; }
 
  private:
-  void FitDirections(const relight::LightParts& parts);
-  LightSet Combine(const relight::LightParts& parts) const;
-  double ErrorOf(const LightSet& lights, const relight::LightParts& parts) const;
+  void FitDirections(const estimation::LightParts& parts);
+  LightSet Combine(const estimation::LightParts& parts) const;
+  double ErrorOf(const LightSet& lights, const estimation::LightParts& parts) const;
 
   int n_;
   const scene::RayCaster& model_;

@@ -38,7 +38,7 @@ relight::EnvBasis SyntheticBasis() {
 }
 
 // The mean relative error of `lights` against the exact irradiance of the basis under `parts`.
-double MeanError(const relight::EnvBasis& basis, const relight::LightParts& parts, const LightSet& lights) {
+double MeanError(const relight::EnvBasis& basis, const estimation::LightParts& parts, const LightSet& lights) {
   scene::HdrImage map{kWidth, kHeight, {}};
   for (size_t t = 0; t < basis.sun.size(); ++t) {
     const glm::vec3 l = parts.sun * basis.sun[t] + parts.clear * basis.clear[t] + parts.overcast * basis.overcast[t];
@@ -56,7 +56,7 @@ TEST(EnvLightsTest, MatchTheMapAndRecombineUnderAnotherLight) {
   // Captured at the objects' centre: the reprojection changes nothing but the sampling.
   EnvLights lights(8, model, 0.5f * (lo + hi), 0.5f * (lo + hi), kWidth, kHeight);
   const relight::EnvBasis basis = SyntheticBasis();
-  relight::LightParts clear_day;
+  estimation::LightParts clear_day;
   clear_day.sun = glm::vec3(900.0f, 850.0f, 800.0f);
   clear_day.clear = glm::vec3(1.0f);
   clear_day.overcast = glm::vec3(20.0f);
@@ -78,14 +78,14 @@ TEST(EnvLightsTest, MatchTheMapAndRecombineUnderAnotherLight) {
   }
   EXPECT_GE(below, 1) << "no light for the ground's reflected sunlight";
   // Somewhat more overcast: the same directions, each part's irradiances recombined.
-  relight::LightParts hazier = clear_day;
+  estimation::LightParts hazier = clear_day;
   hazier.overcast *= 1.5f;
   const double recombined = MeanError(basis, hazier, lights.Update(hazier));
   std::printf("8 lights: %.2f%% with the overcast part 1.5 times stronger\n", 100 * recombined);
   EXPECT_EQ(lights.generation(), 1);
   EXPECT_LT(recombined, 0.05);
   // Linear in the light: twice the light, twice every irradiance.
-  relight::LightParts twice = hazier;
+  estimation::LightParts twice = hazier;
   twice.sun *= 2.0f, twice.clear *= 2.0f, twice.overcast *= 2.0f;
   const LightSet a = lights.Update(hazier), b = lights.Update(twice);
   EXPECT_EQ(lights.generation(), 1);
@@ -95,7 +95,7 @@ TEST(EnvLightsTest, MatchTheMapAndRecombineUnderAnotherLight) {
   }
   // A cloud (the sun a tenth, the sky mostly overcast): recombining would be far off, so the
   // directions are fitted again.
-  relight::LightParts cloudy;
+  estimation::LightParts cloudy;
   cloudy.sun = 0.1f * clear_day.sun;
   cloudy.clear = glm::vec3(0.3f);
   cloudy.overcast = glm::vec3(60.0f);

@@ -23,7 +23,7 @@ ImageLight CompositeStage::Process(const capture::Frame& frame, const estimation
   estimation::SunSky next = row.light;
   if (next_sun.z <= 0.0f) next.sun_rgb = glm::dvec3(0.0);
   renderer_.Linearize(frame, image);
-  relighter_->Apply(relight::SplitLight(row.light, light.overcast_share), relight::SplitLight(next, light.overcast_share),
+  relighter_->Apply(estimation::SplitLight(row.light, light.overcast_share), estimation::SplitLight(next, light.overcast_share),
                     image->data());
   renderer_.RenderLinear(next, light.overcast_share, next_sun, image->data());
   return ImageLight::kOtherLight;
@@ -45,8 +45,8 @@ void RelightStage::Relight(const capture::Frame& frame, const estimation::SunSky
   const estimation::SunSky next_light = relight::NewLight(target_, now_light, now_elevation_deg);
   const double next_overcast = relight::NewOvercastShare(target_, now_overcast_share);
   if (relighter_.SetSuns(now_sun_dir, target_.sun_dir_in_scene) && on_gpu_) on_gpu_->SetTerms(relighter_.terms());
-  const relight::LightParts now = relight::SplitLight(now_light, now_overcast_share);
-  const relight::LightParts next = relight::SplitLight(next_light, next_overcast);
+  const estimation::LightParts now = estimation::SplitLight(now_light, now_overcast_share);
+  const estimation::LightParts next = estimation::SplitLight(next_light, next_overcast);
   const relight::RelightStats stats =
       on_gpu_ ? on_gpu_->Apply(relighter_.terms(), now, next, image->data()) : relighter_.Apply(now, next, image->data());
   clamped_ += stats.clamped, model_pixels_ += stats.model_pixels;

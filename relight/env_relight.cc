@@ -39,12 +39,6 @@ bool EnvRelighter::SetSun(const glm::vec3& sun_dir) {
   return true;
 }
 
-LightParts SplitLight(const estimation::SunSky& light, double overcast_share) {
-  const float o = static_cast<float>(std::clamp(overcast_share, 0.0, 1.0));
-  const glm::vec3 sky(light.sky_rgb);
-  return {glm::vec3(light.sun_rgb), (1.0f - o) * sky, o * sky};
-}
-
 void EnvRelighter::Relight(const estimation::SunSky& light, double overcast_share,
                            std::vector<glm::vec3>* radiance) const {
   const bake::EnvMapMaps& env = bake_.env;
@@ -57,7 +51,7 @@ void EnvRelighter::Relight(const estimation::SunSky& light, double overcast_shar
   for (size_t i = 0; i < model_texels.size(); ++i) {
     const estimation::Transfer& T = terms_[i];
     const uint32_t t = model_texels[i];
-    (*radiance)[t] = env.albedo[t] * glm::one_over_pi<float>() * (e.sun * T.sun + e.clear * T.clear + e.overcast * T.overcast);
+    (*radiance)[t] = env.albedo[t] * glm::one_over_pi<float>() * estimation::Irradiance(e, T);
   }
 }
 

@@ -33,12 +33,9 @@ struct EnvBasis {
   std::vector<glm::vec3> sun, clear, overcast;
 };
 
-// The three lights of the model, RGB: E_sun, E_clear = (1 − o)·E_sky and E_overcast = o·E_sky,
-// the overcast share o clamped to [0, 1]; the weights of EnvBasis's maps.
-struct LightParts {
-  glm::vec3 sun{0.0f}, clear{0.0f}, overcast{0.0f};
-};
-LightParts SplitLight(const estimation::SunSky& light, double overcast_share);
+// The weights of EnvBasis's maps: estimation::LightParts (lighting_model.h), the one radiometric type.
+using estimation::LightParts;
+using estimation::SplitLight;
 
 class EnvRelighter {
  public:

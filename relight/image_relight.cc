@@ -83,8 +83,8 @@ RelightStats ForEachRatio(const RatioTerms& t, const LightParts& now, const Ligh
             per_pixel(p, glm::vec3(1.0f));
             continue;
           }
-          glm::vec3 e_now = now.sun * t.now.sun[p] + now.clear * t.now.clear[p] + now.overcast * t.now.overcast[p];
-          const glm::vec3 e_new = next.sun * t.next.sun[p] + next.clear * t.next.clear[p] + next.overcast * t.next.overcast[p];
+          glm::vec3 e_now = estimation::Irradiance(now, t.now.sun[p], t.now.clear[p], t.now.overcast[p]);
+          const glm::vec3 e_new = estimation::Irradiance(next, t.next.sun[p], t.next.clear[p], t.next.overcast[p]);
           if (kind == kModelPixel) {
             ++stats.model_pixels;
             if (glm::any(glm::lessThan(e_now, floor))) ++stats.clamped, e_now = glm::max(e_now, floor);

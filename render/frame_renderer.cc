@@ -70,7 +70,7 @@ void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcas
   CompositeInput input;
   input.light = light;
   input.sun_dir = sun_dir;
-  const relight::LightParts e = relight::SplitLight(light, overcast_share);
+  const estimation::LightParts e = estimation::SplitLight(light, overcast_share);
   if (volume_ || env_lights_) {
     if (bounce_.SetSun(sun_dir)) compositor_.SetObjectLosses(bounce_.sun_loss(), bounce_.sky_loss());
     // The relit map is linear in E_sun, E_clear and E_overcast, and so are the volume and the

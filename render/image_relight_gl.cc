@@ -86,8 +86,8 @@ void ImageRelightGl::SetTerms(const relight::RatioTerms& terms) {
   for (const uint8_t k : terms.kind) model_pixels_ += k == relight::kModelPixel ? 1 : 0;
 }
 
-relight::RelightStats ImageRelightGl::Apply(const relight::RatioTerms& terms, const relight::LightParts& now,
-                                            const relight::LightParts& next, float* rgb) {
+relight::RelightStats ImageRelightGl::Apply(const relight::RatioTerms& terms, const estimation::LightParts& now,
+                                            const estimation::LightParts& next, float* rgb) {
   Upload(frame_, width_, height_, GL_RGB, GL_FLOAT, rgb);
   glUseProgram(program_.id());
   const glm::vec3 e_now[3] = {now.sun, now.clear, now.overcast}, e_new[3] = {next.sun, next.clear, next.overcast};

@@ -22,8 +22,8 @@ class ImageRelightGl {
   // Uploads the terms (after each ImageRelighter::SetSuns that returned true).
   void SetTerms(const relight::RatioTerms& terms);
   // As relight::ApplyRatio: `rgb` (width × height × 3, linear) times E_new / E_now, in place.
-  relight::RelightStats Apply(const relight::RatioTerms& terms, const relight::LightParts& now,
-                              const relight::LightParts& next, float* rgb);
+  relight::RelightStats Apply(const relight::RatioTerms& terms, const estimation::LightParts& now,
+                              const estimation::LightParts& next, float* rgb);
 
  private:
   int width_, height_;

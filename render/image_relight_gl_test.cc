@@ -34,8 +34,8 @@ TEST(ImageRelightGlTest, MatchesTheCpuPath) {
     if (p % 5 == 0) t.now.sun[p] = t.now.clear[p] = t.now.overcast[p] = glm::vec3(0.001f);  // deep shadow
   }
   t.now_sun = glm::normalize(glm::vec3(0.2f, 0.3f, 0.7f));
-  relight::LightParts now{glm::vec3(80, 60, 40), glm::vec3(8, 9, 10), glm::vec3(2)};
-  relight::LightParts next{glm::vec3(30, 25, 20), glm::vec3(5, 6, 7), glm::vec3(9)};
+  estimation::LightParts now{glm::vec3(80, 60, 40), glm::vec3(8, 9, 10), glm::vec3(2)};
+  estimation::LightParts next{glm::vec3(30, 25, 20), glm::vec3(5, 6, 7), glm::vec3(9)};
   std::vector<float> cpu(3 * n);
   for (float& x : cpu) x = unit(random);
   std::vector<float> gpu = cpu;

@@ -23,7 +23,7 @@ namespace {
 struct Fitted {
   estimation::FrameFit fit;
   std::vector<float> linear;
-  relight::LightParts parts;
+  estimation::LightParts parts;
 };
 
 Fitted Fit(const scene::RayCaster& caster, int frame) {
@@ -31,7 +31,7 @@ Fitted Fit(const scene::RayCaster& caster, int frame) {
   Fitted f{estimation::FitFrame(scene, testing::Courtyard().bake, caster, static_cast<size_t>(frame), {}), {}, {}};
   EXPECT_TRUE(f.fit.fit.IsUsable()) << frame;
   capture::LinearRadiance(f.fit.frame, capture::Linearizer(scene.response), &f.linear);
-  f.parts = relight::SplitLight(f.fit.fit.light, f.fit.fit.overcast_share);
+  f.parts = estimation::SplitLight(f.fit.fit.light, f.fit.fit.overcast_share);
   return f;
 }
 
@@ -73,7 +73,7 @@ TEST(RelightImageRecordingTest, TheRatioIsOneForTheSameLightAndLinearInTheNewOne
   const size_t n = relighter.terms().kind.size();
   std::vector<float> ratio(3 * n);
   relight::RatioOf(relighter.terms(), f.parts, f.parts, ratio.data());
-  relight::LightParts doubled = f.parts;
+  estimation::LightParts doubled = f.parts;
   doubled.sun *= 2.0f, doubled.clear *= 2.0f, doubled.overcast *= 2.0f;
   std::vector<float> twice(3 * n);
   const relight::RelightStats stats = relight::RatioOf(relighter.terms(), f.parts, doubled, twice.data());

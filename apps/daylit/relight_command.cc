@@ -68,7 +68,7 @@ void CompareWithRealFrame(const scene::Scene& scene, const bake::SceneBake& bake
   std::vector<float> before, after;
   capture::LinearRadiance(original.frame, linearizer, &before);
   capture::LinearRadiance(real.frame, linearizer, &after);
-  const relight::SceneLight light{target.sun_dir_in_scene, relight::SplitLight(*target.light, target.overcast_share)};
+  const relight::SceneLight light{target.sun_dir_in_scene, estimation::SplitLight(*target.light, target.overcast_share)};
   const double error = relight::DiffuseError(baked.camera, relit.data(), after.data());
   const std::vector<uint8_t> relit_layout = relight::ShadowLayout(baked.camera, relighter.terms().next, light, relit.data());
   const std::vector<uint8_t> real_layout = relight::ShadowLayout(baked.camera, relighter.terms().next, light, after.data());
