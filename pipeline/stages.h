@@ -52,6 +52,7 @@ class RelightStage final : public FrameStage {
                const glm::vec3& now_sun_dir, double now_elevation_deg, std::vector<float>* image);
 
   const relight::ImageRelighter& relighter() const { return relighter_; }
+  const relight::RelightTarget& target() const { return target_; }
   int relit() const { return relit_; }
   int unrelit() const { return unrelit_; }
   // Of the model's pixels over all frames relit, the share whose E_now was below the floor.

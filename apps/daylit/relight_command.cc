@@ -89,10 +89,10 @@ void CompareWithRealFrame(const scene::Scene& scene, const bake::SceneBake& bake
   Log().info("wrote {} (original | relit | real, the last two at the real frame's exposure)", strip.string());
 }
 
-void RunRelight(const RelightOptions& o) {
+// The output and the options that name the new sun and light, before anything is loaded.
+void CheckRelightOptions(const RelightOptions& o) {
   const fs::path out(o.out);
-  const bool single = o.frame.has_value();
-  if (single) {
+  if (o.frame) {
     const std::string ext = out.extension().string();
     if (ext != ".png" && ext != ".exr") ThrowInputError("--out: {} must end in .png or .exr", o.out);
     if (!o.frames.empty()) ThrowInputError("--frames: not with --frame");
@@ -102,53 +102,126 @@ void RunRelight(const RelightOptions& o) {
   const int given = (o.at.empty() ? 0 : 1) + (o.azimuth || o.elevation ? 1 : 0) + (o.like_frame ? 1 : 0);
   if (given != 1) ThrowInputError("give the new sun one way: --at, --sun-azimuth with --sun-elevation, or --like-frame");
   if (o.azimuth.has_value() != o.elevation.has_value()) ThrowInputError("--sun-azimuth and --sun-elevation go together");
+  if (o.azimuth && !std::isfinite(*o.azimuth)) ThrowInputError("--sun-azimuth: {} is not an angle", *o.azimuth);
+  if (o.elevation && !(*o.elevation >= -90.0 && *o.elevation <= 90.0)) {
+    ThrowInputError("--sun-elevation: {} is outside [-90, 90]", *o.elevation);
+  }
   if (o.sky != "keep" && o.sky != "follow") ThrowInputError("--sky: '{}' is not keep or follow", o.sky);
+}
+
+// --frames a:b (frame numbers, both included, each in frames.csv); both empty without it.
+struct FrameRange {
+  std::optional<int> first;
+  std::optional<size_t> last_position;  // in frames.csv
+};
+FrameRange ParseFrameRange(const scene::Scene& scene, const std::string& text) {
+  FrameRange range;
+  if (text.empty()) return range;
+  const size_t colon = text.find(':');
+  int first = 0, last = 0;
+  try {
+    if (colon == std::string::npos) throw std::invalid_argument("");
+    size_t used = 0;
+    first = std::stoi(text.substr(0, colon), &used);
+    if (used != colon) throw std::invalid_argument("");
+    last = std::stoi(text.substr(colon + 1), &used);
+    if (used != text.size() - colon - 1) throw std::invalid_argument("");
+  } catch (const std::exception&) {
+    ThrowInputError("--frames: '{}' is not a:b (frame numbers)", text);
+  }
+  if (last < first) ThrowInputError("--frames: {} ends before it starts", text);
+  scene::FramePosition(scene, first, "--frames");
+  range.first = first;
+  range.last_position = scene::FramePosition(scene, last, "--frames");
+  return range;
+}
+
+// The new sun from --at or --sun-azimuth/--sun-elevation (--like-frame needs the bake: LikeFrame),
+// and the new light's options. `month_utc`: the month for the clear-sky model without --at.
+relight::RelightTarget TargetFromOptions(const RelightOptions& o, const scene::Scene& scene, int month_utc) {
   relight::RelightTarget target;
   target.clear_sky = o.clear_sky;
   if (!o.e_sun.empty()) target.e_sun = RgbOption(o.e_sun, "--e-sun");
   if (!o.e_sky.empty()) target.e_sky = RgbOption(o.e_sky, "--e-sky");
-  const scene::Scene scene = scene::LoadScene(o.recording);
-  if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
-  // The frames: one, or a range of frame numbers (a:b, both included).
-  std::optional<int> first, last;
-  std::optional<size_t> last_position;
-  if (!o.frames.empty()) {
-    const size_t colon = o.frames.find(':');
-    try {
-      if (colon == std::string::npos) throw std::invalid_argument("");
-      size_t used = 0;
-      first = std::stoi(o.frames.substr(0, colon), &used);
-      if (used != colon) throw std::invalid_argument("");
-      last = std::stoi(o.frames.substr(colon + 1), &used);
-      if (used != o.frames.size() - colon - 1) throw std::invalid_argument("");
-    } catch (const std::exception&) {
-      ThrowInputError("--frames: '{}' is not a:b (frame numbers)", o.frames);
-    }
-    if (*last < *first) ThrowInputError("--frames: {} ends before it starts", o.frames);
-    scene::FramePosition(scene, *first, "--frames");
-    last_position = scene::FramePosition(scene, *last, "--frames");
-  }
-  const size_t position = single ? scene::FramePosition(scene, *o.frame, "--frame") : 0;
-
-  // The new sun.
-  const sunmodel::SceneGeoFrame geo = scene.GeoFrame();
   if (!o.at.empty()) {
     const UtcTime utc = ParseUtcTime(o.at, "--at");
     const scene::SceneSun at = scene::SunAt(scene, utc);
-    const sunmodel::SunPosition& sun = at.position;
     target.sun_dir_in_scene = glm::vec3(at.dir);
-    target.sun_elevation_deg = sun.ApparentElevationDeg();
+    target.sun_elevation_deg = at.position.ApparentElevationDeg();
     target.month = utc.month;
-    target.what = fmt::format("the sun at {} ({:.1f}° up, azimuth {:.1f}°)", o.at, target.sun_elevation_deg, sun.azimuth_deg);
+    target.what = fmt::format("the sun at {} ({:.1f}° up, azimuth {:.1f}°)", o.at, target.sun_elevation_deg,
+                              at.position.azimuth_deg);
   } else if (o.azimuth) {
-    if (!std::isfinite(*o.azimuth)) ThrowInputError("--sun-azimuth: {} is not an angle", *o.azimuth);
-    if (!(*o.elevation >= -90.0 && *o.elevation <= 90.0)) ThrowInputError("--sun-elevation: {} is outside [-90, 90]", *o.elevation);
-    target.sun_dir_in_scene = glm::vec3(geo.DirectionInScene(*o.azimuth, 90.0 - *o.elevation));
+    target.sun_dir_in_scene = glm::vec3(scene.GeoFrame().DirectionInScene(*o.azimuth, 90.0 - *o.elevation));
     target.sun_elevation_deg = *o.elevation;
-    target.month = scene.frame_times->frames[position].utc.month;
+    target.month = month_utc;
     target.what = fmt::format("the sun at {:.1f}° up, azimuth {:.1f}°", *o.elevation, *o.azimuth);
   }
+  return target;
+}
 
+// --like-frame: that frame's own fit becomes the new sun and light.
+void LikeFrame(const estimation::FrameFit& like, relight::RelightTarget* target) {
+  if (!like.fit.IsUsable()) ThrowInputError("--like-frame: frame {} has no estimate ({})", like.row.frame, like.fit.message);
+  target->sun_dir_in_scene = like.sun_dir;
+  target->sun_elevation_deg = like.row.sun_elevation_deg;
+  target->month = like.row.time_utc.month;
+  target->light = like.fit.light;
+  target->overcast_share = like.fit.overcast_share;
+  target->what = fmt::format("the sun and light of frame {} ({:.1f}° up, azimuth {:.1f}°)", like.row.frame,
+                             target->sun_elevation_deg, like.row.sun_azimuth_deg);
+}
+
+// --frame N: that frame under its own fit, relit, as PNG or EXR (with --like-frame, compared).
+void RelightOneFrame(const RelightOptions& o, const scene::Scene& scene, const bake::SceneBake& baked,
+                     const scene::RayCaster& caster, size_t position, const std::optional<estimation::FrameFit>& like,
+                     pipeline::RelightStage* stage) {
+  const fs::path out(o.out);
+  const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, position, {});
+  if (!fit.fit.IsUsable()) ThrowInputError("frame {}: no estimate ({}); it cannot be relit", *o.frame, fit.fit.message);
+  std::vector<float> image;
+  stage->Relight(fit.frame, fit.fit.light, fit.fit.overcast_share, fit.sun_dir, fit.row.sun_elevation_deg, &image);
+  const int w = stage->relighter().width(), h = stage->relighter().height();
+  if (out.extension() == ".exr") {
+    scene::WriteRgbExr(out, w, h, image.data());
+  } else {
+    report::WritePng(out, {capture::EncodeToBgr8(image.data(), w, h, fit.frame.exposure, &scene.response)});
+  }
+  Log().info("frame {}: wrote {}", *o.frame, o.out);
+  if (like) CompareWithRealFrame(scene, baked, stage->relighter(), stage->target(), fit, image, *like, out);
+}
+
+// The recording's frames (or --frames a:b) through the pipeline with the relight stage, into a video.
+void RelightVideo(const RelightOptions& o, const scene::Scene& scene, const bake::SceneBake& baked,
+                  const scene::RayCaster& caster, const FrameRange& range, pipeline::VideoOutput* video,
+                  pipeline::RelightStage* stage) {
+  pipeline::LightingPipelineOptions options;
+  options.progress_label = "relight";
+  const StopOnInterrupt interrupt;
+  options.stop = interrupt.flag();
+  if (range.last_position) options.max_frames = static_cast<int>(*range.last_position) + 1;
+  options.first_output_frame = range.first;
+  pipeline::LightingPipeline lighting(scene, baked, caster, options);
+  lighting.SetStage(stage);
+  lighting.SetVideo(&video->writer());
+  const pipeline::PipelineRun run = lighting.Run(scene::OpenFrameSource(scene));
+  video->Commit();
+  fmt::print("{}: {} frames relit to {} in {:.1f} s ({:.1f} fps)\n", scene.name, stage->relit(), stage->target().what,
+             run.seconds, static_cast<double>(run.frames.size()) / std::max(run.seconds, 1e-9));
+  if (stage->unrelit() > 0) {
+    Log().warn("{} frames had no estimate yet (no usable fit) and are written as they are", stage->unrelit());
+  }
+  Log().info("wrote {}", o.out);
+}
+
+void RunRelight(const RelightOptions& o) {
+  CheckRelightOptions(o);
+  const scene::Scene scene = scene::LoadScene(o.recording);
+  if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
+  const FrameRange range = ParseFrameRange(scene, o.frames);
+  const size_t position = o.frame ? scene::FramePosition(scene, *o.frame, "--frame") : 0;
+  if (o.like_frame) scene::FramePosition(scene, *o.like_frame, "--like-frame");
+  relight::RelightTarget target = TargetFromOptions(o, scene, scene.frame_times->frames[position].utc.month);
   std::string why;
   std::unique_ptr<render::HeadlessGlContext> gl;
   if (o.objects || o.gpu) {
@@ -156,7 +229,7 @@ void RunRelight(const RelightOptions& o) {
     if (gl == nullptr) ThrowSystemError("OpenGL: {}", why);
   }
   std::optional<pipeline::VideoOutput> video;
-  if (!single) video.emplace(out, scene);
+  if (!o.frame) video.emplace(fs::path(o.out), scene);
 
   bool loaded = false;
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, bake::CacheDir(scene, o.cache), &loaded);
@@ -164,14 +237,7 @@ void RunRelight(const RelightOptions& o) {
   std::optional<estimation::FrameFit> like;
   if (o.like_frame) {
     like = estimation::FitFrame(scene, baked, caster, scene::FramePosition(scene, *o.like_frame, "--like-frame"), {});
-    if (!like->fit.IsUsable()) ThrowInputError("--like-frame: frame {} has no estimate ({})", *o.like_frame, like->fit.message);
-    target.sun_dir_in_scene = like->sun_dir;
-    target.sun_elevation_deg = like->row.sun_elevation_deg;
-    target.month = like->row.time_utc.month;
-    target.light = like->fit.light;
-    target.overcast_share = like->fit.overcast_share;
-    target.what = fmt::format("the sun and light of frame {} ({:.1f}° up, azimuth {:.1f}°)", *o.like_frame,
-                              target.sun_elevation_deg, like->row.sun_azimuth_deg);
+    LikeFrame(*like, &target);
   }
   if (target.sun_dir_in_scene.z <= 0.0f) {
     Log().warn("{}: the sun is {:.1f}° below the horizon; a sky-only relight (E_sun = 0)", target.what, -target.sun_elevation_deg);
@@ -183,37 +249,10 @@ void RunRelight(const RelightOptions& o) {
   if (o.objects) renderer = std::make_unique<render::FrameRenderer>(scene, baked, caster);
   pipeline::RelightStage stage(scene, baked, caster, target, options, renderer.get());
   Log().info("relighting to {}{}", target.what, o.gpu ? ", on the GPU path" : "");
-  if (single) {
-    const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, position, {});
-    if (!fit.fit.IsUsable()) ThrowInputError("frame {}: no estimate ({}); it cannot be relit", *o.frame, fit.fit.message);
-    std::vector<float> image;
-    stage.Relight(fit.frame, fit.fit.light, fit.fit.overcast_share, fit.sun_dir, fit.row.sun_elevation_deg, &image);
-    const int w = stage.relighter().width(), h = stage.relighter().height();
-    if (out.extension() == ".exr") {
-      scene::WriteRgbExr(out, w, h, image.data());
-    } else {
-      report::WritePng(out, {capture::EncodeToBgr8(image.data(), w, h, fit.frame.exposure, &scene.response)});
-    }
-    Log().info("frame {}: wrote {}", *o.frame, o.out);
-    if (like) CompareWithRealFrame(scene, baked, stage.relighter(), target, fit, image, *like, out);
+  if (o.frame) {
+    RelightOneFrame(o, scene, baked, caster, position, like, &stage);
   } else {
-    pipeline::LightingPipelineOptions run_options;
-    run_options.progress_label = "relight";
-    const StopOnInterrupt interrupt;
-    run_options.stop = interrupt.flag();
-    if (last_position) run_options.max_frames = static_cast<int>(*last_position) + 1;
-    run_options.first_output_frame = first;
-    pipeline::LightingPipeline lighting(scene, baked, caster, run_options);
-    lighting.SetStage(&stage);
-    lighting.SetVideo(&video->writer());
-    const pipeline::PipelineRun run = lighting.Run(scene::OpenFrameSource(scene));
-    video->Commit();
-    fmt::print("{}: {} frames relit to {} in {:.1f} s ({:.1f} fps)\n", scene.name, stage.relit(), target.what,
-               run.seconds, static_cast<double>(run.frames.size()) / std::max(run.seconds, 1e-9));
-    if (stage.unrelit() > 0) {
-      Log().warn("{} frames had no estimate yet (no usable fit) and are written as they are", stage.unrelit());
-    }
-    Log().info("wrote {}", o.out);
+    RelightVideo(o, scene, baked, caster, range, &*video, &stage);
   }
   if (stage.ClampedShare() > 0.0) {
     Log().info("{:.2f}% of the model's pixels were in deep shadow (E_now below 2% of what open level ground receives); "
