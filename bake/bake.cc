@@ -12,6 +12,7 @@
 
 #include "bake/sampling.h"
 #include "base/error.h"
+#include "base/options_check.h"
 #include "base/statistics.h"
 #include "base/log.h"
 #include "scene/latlong.h"
@@ -327,20 +328,9 @@ cv::Mat LoadDiffuseMask(const scene::Scene& scene, const EnvMapMaps& env) {
 
 }  // namespace
 
-bool BakeOptions::Check(std::string* why) const {
-  if (rays.hemisphere_rays < 16 || rays.hemisphere_rays > 65536) {
-    *why = fmt::format("hemisphere_rays: {} is outside [16, 65536]", rays.hemisphere_rays);
-    return false;
-  }
-  if (gather_directions < 16 || gather_directions > 65536) {
-    *why = fmt::format("gather_directions: {} is outside [16, 65536]", gather_directions);
-    return false;
-  }
-  if (!(rays.offset_m > 0.0f && rays.offset_m <= 0.1f)) {
-    *why = fmt::format("offset_m: {} is outside (0, 0.1]", rays.offset_m);
-    return false;
-  }
-  return true;
+std::string BakeOptions::Check() const {
+  return FirstProblem({Nested("rays", rays.Check()), InClosed("gather_directions", gather_directions, 16, 65536),
+                       Nested("detail", detail.Check())});
 }
 
 std::string BakeOptions::Describe() const {
@@ -364,8 +354,7 @@ glm::vec3 GatherTables::ProbePosition(int i, int j, int k) const {
 
 SceneBake RunBake(const scene::Scene& scene, const BakeOptions& options) {
   if (!scene.envmap) ThrowInputError("{}: envmap: missing (the bake needs the HDR environment map)", scene.file.string());
-  std::string why;
-  if (!options.Check(&why)) ThrowInputError("bake options: {}", why);
+  if (const std::string why = options.Check(); !why.empty()) ThrowInputError("bake options: {}", why);
   SceneBake bake;
   bake.hash = BakeHash(scene, options);
   const scene::RayCaster caster(scene.model);

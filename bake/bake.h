@@ -27,7 +27,7 @@ struct BakeOptions {
   int gather_directions = 512;  // per probe, spherical Fibonacci
   DetailOptions detail;         // camera albedo detail from the recording's frames
 
-  bool Check(std::string* why) const;  // ray counts in [16, 65536], offset in (0, 0.1] m
+  std::string Check() const;  // empty when valid, else the first problem, naming the field
   std::string Describe() const;        // the values, for the cache key and bake.json
 };
 

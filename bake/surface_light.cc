@@ -1,5 +1,7 @@
 #include "bake/surface_light.h"
 
+#include "base/options_check.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -162,6 +164,10 @@ void DirectSun(const scene::RayCaster& caster, const glm::vec3* points, const gl
         direct[i] = 0.0f;
         if (visible != nullptr) visible[i] = 0;
       });
+}
+
+std::string RayOptions::Check() const {
+  return FirstProblem({InClosed("hemisphere_rays", hemisphere_rays, 16, 65536), InOpenClosed("offset_m", offset_m, 0.0f, 0.1f)});
 }
 
 }  // namespace daylit::bake

@@ -3,6 +3,8 @@
 // inverse rendering), and the per-frame sun visibility s.
 #pragma once
 
+#include <string>
+
 #include <cstdint>
 #include <vector>
 
@@ -18,6 +20,8 @@ namespace daylit::bake {
 struct RayOptions {
   int hemisphere_rays = 256;  // per point, stratified cosine-weighted: V within 0.01 (tests)
   float offset_m = 2e-3f;     // ray origins are moved this far along the normal (self-hits)
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 // Radiance of model points the capture point cannot see (the env map shows what hides them):

@@ -1,5 +1,7 @@
 #include "bake/texture_detail.h"
 
+#include "base/options_check.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -139,6 +141,10 @@ std::vector<glm::vec3> CameraTextureDetail(const scene::Scene& scene, const std:
     }
   }
   return detail;
+}
+
+std::string DetailOptions::Check() const {
+  return FirstProblem({InClosed("frames", frames, 1, 1000), InOpenClosed("footprint_scale", footprint_scale, 0.0f, 16.0f)});
 }
 
 }  // namespace daylit::bake

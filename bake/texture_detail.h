@@ -8,6 +8,8 @@
 // drops them.
 #pragma once
 
+#include <string>
+
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -19,6 +21,8 @@ namespace daylit::bake {
 struct DetailOptions {
   int frames = 9;                 // frames spread evenly over the recording
   float footprint_scale = 1.5f;   // env texel footprint × this (the map's pixel filter, bilinear lookup)
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 // D for every camera pixel (1 where unknown: no model point, no frames, too few usable samples).

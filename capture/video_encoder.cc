@@ -1,5 +1,7 @@
 #include "capture/video_encoder.h"
 
+#include "base/options_check.h"
+
 extern "C" {
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
@@ -161,6 +163,11 @@ void RgbToYuv420(const cv::Mat& rgb, uint8_t* y, int y_stride, uint8_t* u, int u
       vv[i] = code(128.0f + 224.0f * rsum);
     }
   }
+}
+
+std::string VideoEncoderOptions::Check() const {
+  if (preset == nullptr || *preset == '\0') return "preset: none given";
+  return FirstProblem({InOpenClosed("fps", fps, 0.0, 1000.0), InClosed("crf", crf, 0, 51)});
 }
 
 }  // namespace daylit::capture

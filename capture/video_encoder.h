@@ -4,6 +4,8 @@
 // value on average (OpenCV's writer, fixed at its default quality, loses 2.7).
 #pragma once
 
+#include <string>
+
 #include <filesystem>
 #include <memory>
 
@@ -15,6 +17,8 @@ struct VideoEncoderOptions {
   double fps = 30.0;
   int crf = 10;                    // libx264 constant rate factor: 0 lossless, 23 its default
   const char* preset = "veryfast";  // libx264 speed/size trade-off
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 class VideoEncoder {

@@ -1,5 +1,9 @@
 #include "composite/object_bounce.h"
 
+#include "base/check.h"
+
+#include "base/options_check.h"
+
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -12,6 +16,7 @@ namespace daylit::composite {
 ObjectBounce::ObjectBounce(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& real,
                            const scene::RayCaster& objects, const ObjectBounceOptions& options)
     : real_(real), objects_(objects), options_(options) {
+  DAYLIT_CHECK(options.Check().empty(), "{}", options.Check());
   // Albedo per real surface, by name from the bake's table.
   std::vector<glm::vec3> albedo(scene.model.surface_names.size(), glm::vec3(0.0f));
   for (const bake::SurfaceAlbedo& a : bake.albedo_table) {
@@ -77,6 +82,11 @@ bool ObjectBounce::SetSun(const glm::vec3& sun_dir) {
   std::fill(sun_loss_.begin(), sun_loss_.end(), glm::vec3(0.0f));
   for (size_t i = 0; i < seen_.size(); ++i) sun_loss_[seen_[i].vertex] += seen_[i].albedo_over_n * lost[i];
   return true;
+}
+
+std::string ObjectBounceOptions::Check() const {
+  return FirstProblem({InClosed("rays", rays, 1, 65536), InClosed("sky_rays", sky_rays, 1, 65536),
+                       InOpenClosed("offset_m", offset_m, 0.0f, 0.1f)});
 }
 
 }  // namespace daylit::composite

@@ -9,6 +9,8 @@
 // (RGB, ρ the surface's albedo from the bake). A_sky once; A_sun when the sun moves 0.05°.
 #pragma once
 
+#include <string>
+
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -23,6 +25,8 @@ struct ObjectBounceOptions {
   int rays = 64;       // per vertex, cosine-weighted
   int sky_rays = 32;   // per real point seen, for ΔV
   float offset_m = 2e-3f;
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 class ObjectBounce {

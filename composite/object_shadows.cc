@@ -1,5 +1,9 @@
 #include "composite/object_shadows.h"
 
+#include "base/check.h"
+
+#include "base/options_check.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -28,6 +32,7 @@ bool RayMeetsSphere(const glm::vec3& origin, const glm::vec3& dir, const glm::ve
 ObjectShadows::ObjectShadows(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& real,
                              const scene::RayCaster& objects, const ObjectShadowOptions& options)
     : gbuffer_(bake.camera), real_(real), objects_(objects), options_(options) {
+  DAYLIT_CHECK(options.Check().empty(), "{}", options.Check());
   const bake::CameraGBuffer& gbuffer = bake.camera;
   // Bounding spheres from the meshes themselves (surface i of the objects' model is object i).
   std::vector<glm::vec3> lo, hi;
@@ -268,6 +273,11 @@ size_t ObjectShadows::SkyLossPixels() const {
 
 size_t ObjectShadows::ShadowPixels() const {
   return static_cast<size_t>(std::count_if(affected_.begin(), affected_.end(), [](const Affected& a) { return a.sun_lost > 0.0f; }));
+}
+
+std::string ObjectShadowOptions::Check() const {
+  return FirstProblem({InClosed("sky_rays", sky_rays, 16, 65536), InOpenClosed("reach_radii", reach_radii, 0.0f, 1000.0f),
+                       InOpenClosed("offset_m", offset_m, 0.0f, 0.1f), InClosed("sun_rays", sun_rays, 1, 1024)});
 }
 
 }  // namespace daylit::composite

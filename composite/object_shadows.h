@@ -17,6 +17,8 @@
 // the sun whenever it moves by more than 0.05°.
 #pragma once
 
+#include <string>
+
 #include <cstdint>
 #include <vector>
 
@@ -36,6 +38,8 @@ struct ObjectShadowOptions {
                                // lose under 0.7% of their light to it and are skipped
   float offset_m = 2e-3f;      // ray origins off the surface, as in the bake
   int sun_rays = 16;           // over the sun's 0.53° disc, for penumbrae
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 class ObjectShadows {

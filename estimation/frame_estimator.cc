@@ -1,5 +1,7 @@
 #include "estimation/frame_estimator.h"
 
+#include "base/options_check.h"
+
 #include <fmt/format.h>
 
 #include "base/check.h"
@@ -20,7 +22,9 @@ FrameEstimator::FrameEstimator(const scene::Scene& scene, const bake::SceneBake&
       options_(options),
       sampler_(bake, CapturePoint(scene), caster, options.sampler),
       filter_(options.filter),
-      linearizer_(scene.response) {}
+      linearizer_(scene.response) {
+  DAYLIT_CHECK(options.Check().empty(), "{}", options.Check());
+}
 
 FrameEstimate FrameEstimator::Row(const capture::Frame& frame, const scene::TrackedSun& sun) const {
   FrameEstimate row;
@@ -115,6 +119,10 @@ std::string EstimatesCsv(const std::vector<FrameEstimate>& frames) {
                    f.confidence, f.samples);
   }
   return fmt::to_string(out);
+}
+
+std::string FrameEstimatorOptions::Check() const {
+  return FirstProblem({Nested("sampler", sampler.Check()), Nested("fit", fit.Check()), Nested("filter", filter.Check())});
 }
 
 }  // namespace daylit::estimation

@@ -22,6 +22,8 @@ struct FrameEstimatorOptions {
   SamplerOptions sampler;
   SunSkyFitOptions fit;
   TemporalFilterOptions filter;
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 // One row of estimates.csv.

@@ -1,5 +1,9 @@
 #include "estimation/sampler.h"
 
+#include "base/check.h"
+
+#include "base/options_check.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -16,6 +20,7 @@ Sampler::Sampler(const bake::SceneBake& bake, const glm::vec3& capture_position,
                  SamplerOptions options)
     : gbuffer_(bake.camera), caster_(caster), options_(options),
       transfer_(bake, TransferPoints::Camera(bake.camera), capture_position, caster, options.transfer) {
+  DAYLIT_CHECK(options.Check().empty(), "{}", options.Check());
   const bake::CameraGBuffer& gbuffer = bake.camera;
   for (size_t i = 0; i < gbuffer.diffuse.size(); ++i) {
     if (gbuffer.diffuse[i]) diffuse_pixels_.push_back(static_cast<uint32_t>(i));
@@ -120,6 +125,12 @@ std::vector<Sample> Sampler::Draw(const cv::Mat& frame, double exposure, const c
     }
   }
   return samples;
+}
+
+std::string SamplerOptions::Check() const {
+  return FirstProblem({InClosed("samples", samples, 100, 1000000), InClosed("boundary_margin_px", boundary_margin_px, 0, 50),
+                       InOpenClosed("saturated", saturated, 0.0, 1.0), InClosed("near_black", near_black, 0.0, saturated),
+                       InClosed("pool", pool, 1.0, 100.0), Nested("transfer", transfer.Check())});
 }
 
 }  // namespace daylit::estimation

@@ -6,6 +6,8 @@
 // the transfer terms (estimation/transfer.h) of the pixels each stratum may use.
 #pragma once
 
+#include <string>
+
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -29,6 +31,8 @@ struct SamplerOptions {
   double pool = 1.5;                 // pixels per stratum given transfer terms, in units of its quota
                                      // (room for pixels a frame skips as clipped or black)
   TransferOptions transfer;
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 class Sampler {

@@ -1,5 +1,7 @@
 #include "estimation/sun_sky_fit.h"
 
+#include "base/options_check.h"
+
 #include "base/statistics.h"
 
 #include <algorithm>
@@ -84,15 +86,11 @@ ChannelFit SolveNonNegative(const NormalEquations& eq, const std::array<bool, 3>
 
 }  // namespace
 
-bool SunSkyFitOptions::Check(std::string* why) const {
-  if (!(cauchy_scale > 0.0) || iterations < 1 || !(sunlit_threshold > 0.0 && sunlit_threshold < 1.0) ||
-      min_stratum_samples < 1 || !(confident_residual > 0.0)) {
-    *why = fmt::format("sun/sky fit options out of range (cauchy_scale {}, iterations {}, sunlit_threshold {}, "
-                       "min_stratum_samples {}, confident_residual {})",
-                       cauchy_scale, iterations, sunlit_threshold, min_stratum_samples, confident_residual);
-    return false;
-  }
-  return true;
+std::string SunSkyFitOptions::Check() const {
+  return FirstProblem({InOpenClosed("cauchy_scale", cauchy_scale, 0.0, 10.0), InClosed("iterations", iterations, 1, 1000),
+                       InOpenClosed("sunlit_threshold", sunlit_threshold, 0.0, 0.999),
+                       InClosed("min_stratum_samples", min_stratum_samples, 1, 1000000),
+                       InOpenClosed("confident_residual", confident_residual, 0.0, 10.0)});
 }
 
 SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sample>& samples) {

@@ -42,7 +42,8 @@ struct SunSkyFitOptions {
                                     // (textured albedo and model gaps leave ~0.1-0.2 on real scenes)
   bool split_sky = true;            // fit E_clear and E_overcast apart (when the samples differ)
 
-  bool Check(std::string* why) const;
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 enum class SunSkyFitStatus {

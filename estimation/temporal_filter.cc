@@ -1,5 +1,7 @@
 #include "estimation/temporal_filter.h"
 
+#include "base/options_check.h"
+
 #include "base/statistics.h"
 
 #include <algorithm>
@@ -59,6 +61,13 @@ FilteredLight TemporalFilter::Update(double time_s, const std::optional<SunSky>&
   }
   state_->confidence += options_.smoothing * (confidence - state_->confidence);
   return *state_;
+}
+
+std::string TemporalFilterOptions::Check() const {
+  if (median_window % 2 == 0) return fmt::format("median_window: {} frames is not odd", median_window);
+  return FirstProblem({InClosed("median_window", median_window, 1, 99), InClosed("noise_band", noise_band, 0.0, 1.0),
+                       InOpenClosed("smoothing", smoothing, 0.0, 1.0), InClosed("min_confidence", min_confidence, 0.0, 1.0),
+                       InOpenClosed("restart_gap_s", restart_gap_s, 0.0, 1e9)});
 }
 
 }  // namespace daylit::estimation

@@ -12,6 +12,8 @@
 // tested). The per-frame fits on courtyard-a jitter by about 1%, well inside the band.
 #pragma once
 
+#include <string>
+
 #include <deque>
 #include <optional>
 
@@ -25,6 +27,8 @@ struct TemporalFilterOptions {
   double smoothing = 0.3;        // per-frame gain within the band, in (0, 1]
   double min_confidence = 0.05;  // fits below this do not move the estimate (the first one starts it)
   double restart_gap_s = 60.0;   // a longer gap between frames restarts the filter
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 struct FilteredLight {

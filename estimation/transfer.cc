@@ -1,5 +1,7 @@
 #include "estimation/transfer.h"
 
+#include "base/options_check.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -28,14 +30,9 @@ scene::HdrImage ImageOf(const bake::EnvMapMaps& env) {
 
 }  // namespace
 
-bool TransferOptions::Check(std::string* why) const {
-  if (rays < 8 || rays > 65536 || bounces < 1 || bounces > 8 || hidden_sky_rays < 8 || hidden_sky_rays > 65536 || !(offset_m > 0.0f && offset_m <= 0.1f)) {
-    *why = fmt::format("transfer options out of range (rays {} and hidden_sky_rays {} must be in [8, 65536], bounces "
-                       "{} in [1, 8], offset {} m in (0, 0.1])",
-                       rays, hidden_sky_rays, bounces, offset_m);
-    return false;
-  }
-  return true;
+std::string TransferOptions::Check() const {
+  return FirstProblem({InClosed("rays", rays, 8, 65536), InClosed("hidden_sky_rays", hidden_sky_rays, 8, 65536),
+                       InOpenClosed("offset_m", offset_m, 0.0f, 0.1f), InClosed("bounces", bounces, 1, 8)});
 }
 
 TransferPoints TransferPoints::Camera(const bake::CameraGBuffer& g) {

@@ -47,7 +47,8 @@ struct TransferOptions {
   int bounces = 3;              // the first exact, the others through per-surface means
   bool sky_distribution = true; // the captured sky's (θ, γ) distribution; false: a uniform sky
 
-  bool Check(std::string* why) const;
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 // The points a LightTransfer works on: what the bake knows of each (arrays of `count`).

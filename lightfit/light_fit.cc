@@ -1,5 +1,7 @@
 #include "lightfit/light_fit.h"
 
+#include "base/options_check.h"
+
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -169,6 +171,7 @@ void LightFitResidual(const LightSet& initial, const glm::vec3& normal, const gl
 
 LightFitResult FitLights(const std::vector<glm::vec3>& normals, const std::vector<glm::dvec3>& truth,
                          const LightSet& initial, const LightFitOptions& options) {
+  DAYLIT_CHECK(options.Check().empty(), "{}", options.Check());
   const std::vector<Target> targets = TargetsOf(normals, truth);
   std::vector<AngleFrame> frames;
   for (const DirectionalLight& l : initial.lights) frames.emplace_back(l.direction);
@@ -242,6 +245,13 @@ LightFitResult IrradianceOptimization(const scene::HdrImage& map, int n, const L
   for (size_t i = 0; i < normals.size(); ++i) unexplained = glm::min(unexplained, truth[i] - initial.Irradiance(normals[i]));
   if (options.ambient) initial.ambient = glm::vec3(glm::max(unexplained, glm::dvec3(0.0)));
   return FitLights(normals, truth, initial, options);
+}
+
+std::string LightFitOptions::Check() const {
+  return FirstProblem({InClosed("max_iterations", max_iterations, 1, 100000),
+                       InOpenClosed("function_tolerance", function_tolerance, 0.0, 1.0),
+                       InClosed("stall_window", stall_window, 1, 100000), InClosed("stall_fraction", stall_fraction, 0.0, 1.0),
+                       InClosed("threads", threads, 1, 256)});
 }
 
 }  // namespace daylit::lightfit

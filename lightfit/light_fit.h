@@ -29,6 +29,8 @@ struct LightFitOptions {
   int stall_window = 10;
   double stall_fraction = 0.01;
   int threads = 2;
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 struct LightFitResult {

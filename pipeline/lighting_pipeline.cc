@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "base/check.h"
+#include "base/options_check.h"
 #include "base/log.h"
 #include "base/progress.h"
 #include "base/statistics.h"
@@ -23,7 +24,7 @@ double MillisecondsSince(Clock::time_point t0) { return 1e3 * std::chrono::durat
 
 std::string LightingPipelineOptions::Check() const {
   if (max_frames && *max_frames < 1) return fmt::format("max_frames: {} is not a number of frames (≥ 1)", *max_frames);
-  return sun.Check();
+  return FirstProblem({Nested("estimator", estimator.Check()), Nested("sun", sun.Check())});
 }
 
 LightingPipeline::LightingPipeline(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,

@@ -1,5 +1,7 @@
 #include "pipeline/stages.h"
 
+#include "base/options_check.h"
+
 #include <algorithm>
 
 namespace daylit::pipeline {
@@ -68,5 +70,7 @@ ImageLight RelightStage::Process(const capture::Frame& frame, const estimation::
 double RelightStage::ClampedShare() const {
   return static_cast<double>(clamped_) / static_cast<double>(std::max<size_t>(model_pixels_, 1));
 }
+
+std::string RelightStageOptions::Check() const { return Nested("relight", relight.Check()); }
 
 }  // namespace daylit::pipeline

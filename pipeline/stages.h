@@ -3,6 +3,8 @@
 // objects under that light), and the relit frame of daylit relight.
 #pragma once
 
+#include <string>
+
 #include <memory>
 #include <vector>
 
@@ -36,6 +38,8 @@ class CompositeStage final : public FrameStage {
 struct RelightStageOptions {
   relight::ImageRelightOptions relight;
   bool gpu = false;  // ratio and modulation in GL (render::ImageRelightGl); needs a current context
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 class RelightStage final : public FrameStage {

@@ -1,5 +1,9 @@
 #include "relight/image_relight.h"
 
+#include "base/check.h"
+
+#include "base/options_check.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -17,6 +21,7 @@ ImageRelighter::ImageRelighter(const scene::Scene& scene, const bake::SceneBake&
                                ImageRelightOptions options)
     : surface_(bake, estimation::TransferPoints::Camera(bake.camera), bake.camera.width, bake.camera.height, false,
                scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f), caster, options.transfer) {
+  DAYLIT_CHECK(options.Check().empty(), "{}", options.Check());
   const int width = bake.camera.width;
   terms_.width = width, terms_.height = bake.camera.height;
   terms_.floor = options.floor;
@@ -182,6 +187,10 @@ glm::dvec2 ClearSkyFactors(double from_deg, double to_deg, int month) {
   if (from <= 0.0 || to <= 0.0) return {0.0, 1.0};
   // DHI = C·DNI on a horizontal surface: the same factor as the DNI's, C being per month.
   return {to / from, to / from};
+}
+
+std::string ImageRelightOptions::Check() const {
+  return FirstProblem({InOpenClosed("floor", floor, 0.0f, 1.0f), Nested("transfer", transfer.Check())});
 }
 
 }  // namespace daylit::relight

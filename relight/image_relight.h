@@ -16,6 +16,8 @@
 // and the camera's noise there is not amplified without limit. Such pixels are counted.
 #pragma once
 
+#include <string>
+
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -37,6 +39,8 @@ struct ImageRelightOptions {
   SkyPixels sky = SkyPixels::kKeep;
   float floor = 0.02f;  // of open level ground's irradiance now
   estimation::TransferOptions transfer;
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 // One lighting of the scene: the unit sun (scene coordinates; z ≤ 0: below the horizon, no sun

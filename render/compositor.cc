@@ -1,5 +1,7 @@
 #include "render/compositor.h"
 
+#include "base/options_check.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -309,6 +311,7 @@ Compositor::Rect ProjectedRect(const std::vector<glm::vec3>& vertices, const glm
 }  // namespace
 
 Compositor::Compositor(const scene::Scene& scene, const CompositorOptions& options) : gl_(std::make_unique<Gl>()) {
+  DAYLIT_CHECK(options.Check().empty(), "{}", options.Check());
   Gl& g = *gl_;
   g.options = options;
   DAYLIT_CHECK(options.lights >= 0 && options.lights <= kMaxLights, "{} lights; 0 to {}", options.lights, kMaxLights);
@@ -522,6 +525,12 @@ void Compositor::Render(const CompositeInput& input, float* image) {
     }
   }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+std::string CompositorOptions::Check() const {
+  if (samples != 1 && samples != 2 && samples != 4 && samples != 8) return fmt::format("samples: {} is not 1, 2, 4 or 8", samples);
+  return FirstProblem({InClosed("shadow_map_size", shadow_map_size, 64, 16384), InClosed("lights", lights, 0, kMaxLights),
+                       InClosed("light_shadow_map_size", light_shadow_map_size, 64, 16384)});
 }
 
 }  // namespace daylit::render

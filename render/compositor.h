@@ -15,6 +15,8 @@
 // Needs a current GL 3.3 core context (render/gl_context.h).
 #pragma once
 
+#include <string>
+
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -45,6 +47,8 @@ struct CompositorOptions {
   int shadow_map_size = 2048;  // texels over the objects' bounds, seen from the sun
   int lights = 0;                    // the number of CompositeInput::lights it is made for (0 to 16)
   int light_shadow_map_size = 1024;  // the shadow map's size for each of them
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 class Compositor {

@@ -1,5 +1,7 @@
 #include "render/frame_renderer.h"
 
+#include "base/options_check.h"
+
 #include "base/check.h"
 #include "base/error.h"
 #include "scene/object_mesh.h"
@@ -26,6 +28,7 @@ FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& b
       relighter_(bake, scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f), caster),
       compositor_(scene, CompositorFor(options, scene)),
       linearizer_(scene.response) {
+  DAYLIT_CHECK(options.Check().empty(), "{}", options.Check());
   scene::CheckObjectsOutsideModel(objects_model_, caster, scene.file.string());
   if (options.lights == 0 && !bake.gather.directions.empty()) {
     volume_ = std::make_unique<sh::IrradianceVolume>(bake.gather, sh::ProbesInsideModel(bake.gather, caster));
@@ -102,6 +105,11 @@ void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcas
   shadows_.SetSun(sun_dir);
   shadows_.Apply(light, overcast_share, image);
   compositor_.Render(input, image);
+}
+
+std::string FrameRendererOptions::Check() const {
+  return FirstProblem({Nested("compositor", compositor.Check()),
+                       InClosed("lights", lights, 0, lightfit::EnvLights::kMaxLights)});
 }
 
 }  // namespace daylit::render

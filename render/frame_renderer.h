@@ -30,6 +30,8 @@ struct FrameRendererOptions {
   // and an ambient term fitted to the relit env map (lightfit::EnvLights), each casting shadows
   // (daylit render/replay --lighting lights:N).
   int lights = 0;
+  // Empty when every field is in range, else the first problem, naming the field.
+  std::string Check() const;
 };
 
 // "volume" → 0, "lights:N" → N (1..16); InputError "<where>: ..." otherwise.

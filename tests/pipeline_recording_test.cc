@@ -113,6 +113,14 @@ TEST(PipelineRecordingTest, OptionsAreCheckedBeforeAnyWork) {
   options.max_frames = 3;
   options.sun.move_threshold_deg = -1.0;
   EXPECT_NE(options.Check().find("sun.move_threshold_deg"), std::string::npos);
+  options.sun = {};
+  options.estimator.sampler.transfer.bounces = 0;
+  EXPECT_EQ(options.Check(), "estimator.sampler.transfer.bounces: 0 is outside [1, 8]");
+  options.estimator.sampler.transfer.bounces = 3;
+  options.estimator.filter.median_window = 4;
+  EXPECT_EQ(options.Check(), "estimator.filter.median_window: 4 frames is not odd");
+  options.estimator.filter.median_window = 1;
+  EXPECT_EQ(options.Check(), "");
 }
 
 }  // namespace

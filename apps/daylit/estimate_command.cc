@@ -7,6 +7,7 @@
 
 #include "apps/daylit/commands.h"
 #include "bake/bake.h"
+#include "base/error.h"
 #include "base/log.h"
 #include "evaluation/lighting_truth.h"
 #include "evaluation/run_report.h"
@@ -26,6 +27,7 @@ struct EstimateCommandOptions {
 };
 
 void RunEstimateCommand(const EstimateCommandOptions& o) {
+  if (const std::string why = o.pipeline.Check(); !why.empty()) ThrowInputError("options: {}", why);
   const scene::Scene scene = scene::LoadScene(o.recording);
   // The frames first: a camera that is not there is an error now, not after the bake.
   std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
