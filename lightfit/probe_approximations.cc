@@ -8,38 +8,38 @@
 
 namespace daylit::lightfit {
 
-const char* MethodKey(Method method) {
-  switch (method) {
-    case Method::kMedianCut: return "mediancut";
-    case Method::kIrradianceOptimization: return "io";
-    case Method::kSh9: return "sh";
+namespace {
+
+struct MethodInfo {
+  Method method;
+  const char* key;
+  const char* name;
+  int max_lights;
+};
+constexpr MethodInfo kMethods[] = {
+    {Method::kMedianCut, "mediancut", "median cut", 1024},
+    {Method::kIrradianceOptimization, "io", "irradiance optimization", 128},
+    {Method::kSh9, "sh", "SH9", 9},
+};
+
+const MethodInfo& InfoOf(Method method) {
+  for (const MethodInfo& info : kMethods) {
+    if (info.method == method) return info;
   }
-  return "";
+  DAYLIT_CHECK(false, "method {}", static_cast<int>(method));
 }
 
-const char* MethodName(Method method) {
-  switch (method) {
-    case Method::kMedianCut: return "median cut";
-    case Method::kIrradianceOptimization: return "irradiance optimization";
-    case Method::kSh9: return "SH9";
-  }
-  return "";
-}
+}  // namespace
+
+const char* MethodKey(Method method) { return InfoOf(method).key; }
+const char* MethodName(Method method) { return InfoOf(method).name; }
+int MaxLights(Method method) { return InfoOf(method).max_lights; }
 
 std::optional<Method> ParseMethod(const std::string& key) {
-  for (const Method m : {Method::kMedianCut, Method::kIrradianceOptimization, Method::kSh9}) {
-    if (key == MethodKey(m)) return m;
+  for (const MethodInfo& info : kMethods) {
+    if (key == info.key) return info.method;
   }
   return std::nullopt;
-}
-
-int MaxLights(Method method) {
-  switch (method) {
-    case Method::kMedianCut: return 1024;
-    case Method::kIrradianceOptimization: return 128;
-    case Method::kSh9: return 9;
-  }
-  return 0;
 }
 
 ProbeApproximations::ProbeApproximations(const scene::HdrImage& map, const LightFitOptions& fit)

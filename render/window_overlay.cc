@@ -31,7 +31,7 @@ void DrawOverlay(cv::Mat* bgr, double fps, const estimation::FrameEstimate& row,
 
 int SliderBar::X(double fraction) const { return x0 + static_cast<int>(std::lround(fraction * (x1 - x0))); }
 
-void ApplyInput(const WindowInput& input, const UtcTime& frame_utc, const SliderBar& bar, render::TimeSlider* slider) {
+void ApplyInput(const WindowInput& input, const UtcTime& frame_utc, const SliderBar& bar, TimeSlider* slider) {
   for (const WindowKey key : input.keys) {
     switch (key) {
       case WindowKey::kLeft: slider->Step(-15, frame_utc); break;
@@ -46,7 +46,7 @@ void ApplyInput(const WindowInput& input, const UtcTime& frame_utc, const Slider
   }
 }
 
-void DrawTimeSlider(cv::Mat* bgr, const render::TimeSlider& slider, const scene::Scene& scene, const UtcTime& frame_utc,
+void DrawTimeSlider(cv::Mat* bgr, const TimeSlider& slider, const scene::Scene& scene, const UtcTime& frame_utc,
                     const std::optional<scene::SceneSun>& relit_sun, SunlitDay* day) {
   const SliderBar bar = SliderBar::Of(bgr->cols, bgr->rows);
   const double midnight = UnixSeconds(slider.AtFraction(frame_utc, 0.0));
@@ -78,7 +78,7 @@ void DrawTimeSlider(cv::Mat* bgr, const render::TimeSlider& slider, const scene:
     text(target ? "no estimate yet: shown as it is" : "time of day: <- -> 15 min, up/down 1 h, or click the bar");
     return;
   }
-  const int x = bar.X(*slider.solar_minutes() / render::TimeSlider::kDayMinutes);
+  const int x = bar.X(*slider.solar_minutes() / TimeSlider::kDayMinutes);
   cv::circle(*bgr, {x, bar.y + bar.height / 2}, 7, cv::Scalar(0, 200, 255), cv::FILLED, cv::LINE_AA);
   cv::circle(*bgr, {x, bar.y + bar.height / 2}, 7, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   const int solar = static_cast<int>(std::lround(*slider.solar_minutes()));

@@ -31,7 +31,7 @@ struct SliderBar {
 
 // Arrow keys move the slider by 15 min (left, right) or an hour (down, up); Backspace turns it off
 // (the frame's own time); a click or drag on the bar puts it there.
-void ApplyInput(const WindowInput& input, const UtcTime& frame_utc, const SliderBar& bar, render::TimeSlider* slider);
+void ApplyInput(const WindowInput& input, const UtcTime& frame_utc, const SliderBar& bar, TimeSlider* slider);
 
 // Where the sun is up over one solar day, sampled every 10 minutes, for shading the bar's night;
 // kept between frames and recomputed when the day changes.
@@ -42,7 +42,7 @@ struct SunlitDay {
 
 // The bar, the frame's time on it, and the slider's target with its sun (`relit_sun`: null when
 // the frame is shown as it is).
-void DrawTimeSlider(cv::Mat* bgr, const render::TimeSlider& slider, const scene::Scene& scene, const UtcTime& frame_utc,
+void DrawTimeSlider(cv::Mat* bgr, const TimeSlider& slider, const scene::Scene& scene, const UtcTime& frame_utc,
                     const std::optional<scene::SceneSun>& relit_sun, SunlitDay* day);
 
 }  // namespace daylit::render

@@ -16,12 +16,10 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "base/progress.h"
-#include "sh/exact_irradiance.h"
 #include "lightfit/light_fit.h"
 #include "lightfit/lights.h"
 #include "lightfit/probe.h"
 #include "lightfit/probe_approximations.h"
-#include "sh/sh9.h"
 #include "report/plot.h"
 
 namespace daylit::app {

@@ -220,7 +220,7 @@ void RunRelight(const RelightOptions& o) {
   if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
   const FrameRange range = ParseFrameRange(scene, o.frames);
   const size_t position = o.frame ? scene::FramePosition(scene, *o.frame, "--frame") : 0;
-  if (o.like_frame) scene::FramePosition(scene, *o.like_frame, "--like-frame");
+  const size_t like_position = o.like_frame ? scene::FramePosition(scene, *o.like_frame, "--like-frame") : 0;
   relight::RelightTarget target = TargetFromOptions(o, scene, scene.frame_times->frames[position].utc.month);
   std::string why;
   std::unique_ptr<render::HeadlessGlContext> gl;
@@ -236,7 +236,7 @@ void RunRelight(const RelightOptions& o) {
   const scene::RayCaster caster(scene.model);
   std::optional<estimation::FrameFit> like;
   if (o.like_frame) {
-    like = estimation::FitFrame(scene, baked, caster, scene::FramePosition(scene, *o.like_frame, "--like-frame"), {});
+    like = estimation::FitFrame(scene, baked, caster, like_position, {});
     LikeFrame(*like, &target);
   }
   if (target.sun_dir_in_scene.z <= 0.0f) {
