@@ -93,6 +93,166 @@ std::string SunSkyFitOptions::Check() const {
                        InOpenClosed("confident_residual", confident_residual, 0.0, 10.0)});
 }
 
+namespace {
+
+// The robust fit of one channel over a set of samples, with the buffers it reuses from channel to
+// channel. Load sets up the regressors; Start, Reweight and Residuals are the three steps.
+class ChannelFitter {
+ public:
+  ChannelFitter(const SunSkyFitOptions& options, const std::vector<Sample>& samples, size_t count, bool with_sun)
+      : options_(options), samples_(samples), with_sun_(with_sun), y_(count), w_(count), relative_(count),
+        x_{std::vector<double>(count), std::vector<double>(count), std::vector<double>(count)},
+        stride_(std::max<size_t>(1, count / 2000)) {
+    scratch_.reserve(count);
+  }
+
+  // Medians (start, floor, spread) are taken over every stride()-th sample: ~2000 of them give
+  // each to well under 1% and cost a quarter of the time.
+  size_t stride() const { return stride_; }
+  // After Fit: the samples' residuals relative to the prediction, in the order of `rows`.
+  const std::vector<double>& relative() const { return relative_; }
+  bool converged() const { return converged_; }
+
+  // Channel `c` over the samples `rows`: E_sun and E_sky, or, with `split`, E_sun, E_clear and
+  // E_overcast; without, the sky's regressor is the clear one and the overcast one mixed by
+  // `share`. `start`, if given, replaces the median-based start.
+  ChannelFit Fit(int c, bool split, double share, const ChannelFit* start, const std::vector<size_t>& rows) {
+    Load(c, split, share, rows);
+    ChannelFit fit = start != nullptr ? *start : MedianStart(rows);
+    fit = Reweight(fit, split);
+    for (size_t k = 0; k < m_; ++k) {
+      const double prediction = Predict(fit, k);
+      relative_[k] = (y_[k] - prediction) / std::max(prediction, floor_);
+    }
+    return fit;
+  }
+
+ private:
+  Eigen::Map<Eigen::ArrayXd> Column(std::vector<double>& v) const {
+    return Eigen::Map<Eigen::ArrayXd>(v.data(), static_cast<Eigen::Index>(m_));
+  }
+  double Predict(const ChannelFit& fit, size_t k) const {
+    return x_[0][k] * fit[0] + x_[1][k] * fit[1] + x_[2][k] * fit[2];
+  }
+
+  void Load(int c, bool split, double share, const std::vector<size_t>& rows) {
+    m_ = rows.size();
+    free_ = {with_sun_, true, split};
+    for (size_t k = 0; k < m_; ++k) {
+      const Sample& s = samples_[rows[k]];
+      const double a = s.albedo[c] * glm::one_over_pi<double>();
+      y_[k] = s.radiance[c];
+      x_[0][k] = a * s.sun[c];
+      x_[1][k] = split ? a * s.sky[c] : a * ((1.0 - share) * s.sky[c] + share * s.overcast[c]);
+      x_[2][k] = split ? a * s.overcast[c] : 0.0;
+    }
+  }
+
+  // The weighted normal equations of the samples with the weights in w_ (all three regressors;
+  // an unused one is zero), vectorised by Eigen.
+  NormalEquations Equations() {
+    const Eigen::Map<Eigen::ArrayXd> ey = Column(y_), ex0 = Column(x_[0]), ex1 = Column(x_[1]), ex2 = Column(x_[2]);
+    const Eigen::Map<Eigen::ArrayXd> ew = Column(w_);
+    NormalEquations eq;
+    const Eigen::ArrayXd w0 = ew * ex0, w1 = ew * ex1, w2 = ew * ex2;
+    eq.a[0][0] = (w0 * ex0).sum(), eq.a[0][1] = (w0 * ex1).sum(), eq.a[0][2] = (w0 * ex2).sum();
+    eq.a[1][1] = (w1 * ex1).sum(), eq.a[1][2] = (w1 * ex2).sum(), eq.a[2][2] = (w2 * ex2).sum();
+    eq.b[0] = (w0 * ey).sum(), eq.b[1] = (w1 * ey).sum(), eq.b[2] = (w2 * ey).sum();
+    eq.yy = (ew * ey.square()).sum();
+    eq.a[1][0] = eq.a[0][1], eq.a[2][0] = eq.a[0][2], eq.a[2][1] = eq.a[1][2];
+    return eq;
+  }
+
+  // Robust start, one sky: the sky from the shadowed samples alone, then the sun from the sunlit
+  // ones.
+  ChannelFit MedianStart(const std::vector<size_t>& rows) {
+    ChannelFit fit{0.0, 0.0, 0.0};
+    scratch_.clear();
+    for (size_t k = 0; k < m_; k += stride_) {
+      if (!samples_[rows[k]].sunlit && x_[1][k] > 0.0) scratch_.push_back(y_[k] / x_[1][k]);
+    }
+    fit[1] = MedianInPlace(scratch_, 0.0);
+    if (scratch_.empty()) {
+      Column(w_).setOnes();
+      fit = SolveNonNegative(Equations(), {with_sun_, true, false});
+    }
+    scratch_.clear();
+    for (size_t k = 0; k < m_; k += stride_) {
+      if (IsSunlit(samples_[rows[k]], options_)) scratch_.push_back((y_[k] - x_[1][k] * fit[1]) / x_[0][k]);
+    }
+    if (with_sun_ && !scratch_.empty()) fit[0] = std::max(0.0, MedianInPlace(scratch_, 0.0));
+    return fit;
+  }
+
+  // IRLS from `fit`: Cauchy weights on residuals relative to the prediction, floored at a tenth
+  // of the start's median prediction so that near-black points do not dominate; until the
+  // estimate moves less than a tolerance (relative). The split only feeds the pooled overcast
+  // share, so it stops sooner.
+  ChannelFit Reweight(ChannelFit fit, bool split) {
+    scratch_.clear();
+    for (size_t k = 0; k < m_; k += stride_) scratch_.push_back(Predict(fit, k));
+    floor_ = std::max(1e-12, 0.1 * MedianInPlace(scratch_, 0.0));
+    const double inv_scale = 1.0 / options_.cauchy_scale;
+    const Eigen::Map<Eigen::ArrayXd> ey = Column(y_), ex0 = Column(x_[0]), ex1 = Column(x_[1]), ex2 = Column(x_[2]);
+    Eigen::Map<Eigen::ArrayXd> ew = Column(w_);
+    const double tolerance = split ? 1e-3 : 1e-4;
+    converged_ = false;
+    for (int iteration = 0; iteration < options_.iterations && !converged_; ++iteration) {
+      // Least squares on relative residuals: 1/scale² times the Cauchy weight 1/(1 + r²), that
+      // is 1/(scale² + d²/c²) for a residual d.
+      const Eigen::ArrayXd prediction = ex0 * fit[0] + ex1 * fit[1] + ex2 * fit[2];
+      const Eigen::ArrayXd d = ey - prediction;
+      ew = (prediction.max(floor_).square() + d.square() * (inv_scale * inv_scale)).inverse();
+      const ChannelFit next = SolveNonNegative(Equations(), free_);
+      double change = 0.0;
+      const double size = std::max({next[0], next[1] + next[2], 1e-30});
+      for (size_t j = 0; j < 3; ++j) change = std::max(change, std::abs(next[j] - fit[j]) / size);
+      fit = next;
+      converged_ = change < tolerance;
+    }
+    return fit;
+  }
+
+  const SunSkyFitOptions& options_;
+  const std::vector<Sample>& samples_;
+  const bool with_sun_;
+  std::vector<double> y_, w_, relative_, scratch_;
+  std::array<std::vector<double>, 3> x_;
+  const size_t stride_;
+  size_t m_ = 0;
+  std::array<bool, 3> free_{};
+  double floor_ = 0.0;
+  bool converged_ = false;
+};
+
+// The overcast share of the sky is one number for all channels (clouds are grey): fitted per
+// channel on half the samples, then pooled. Per-channel shares let a small model error in one
+// channel trade sun for sky there. Also returns each channel's split fit in `split_fits`.
+double PooledOvercastShare(ChannelFitter* fitter, const std::vector<size_t>& usable,
+                           std::array<ChannelFit, 3>* split_fits) {
+  std::vector<size_t> every_other;
+  for (size_t k = 0; k < usable.size(); k += 2) every_other.push_back(usable[k]);
+  glm::dvec3 clear(0.0), overcast(0.0);
+  for (int c = 0; c < 3; ++c) {
+    ChannelFit& fit = (*split_fits)[static_cast<size_t>(c)];
+    fit = fitter->Fit(c, true, 0.0, nullptr, every_other);
+    clear[c] = fit[1], overcast[c] = fit[2];
+  }
+  const double sky = glm::compAdd(clear + overcast);
+  return sky > 0.0 ? glm::compAdd(overcast) / sky : 0.0;
+}
+
+// Confidence: small robust residuals, and both strata present (sunlit and shadowed samples are
+// what separates E_sun from E_sky; without sunlit ones E_sun is not observed at all).
+double Confidence(const SunSkyFitOptions& options, const SunSkyFitSummary& summary, bool with_sun) {
+  const double fit_quality = std::exp(-std::pow(summary.residual_spread / options.confident_residual, 2.0));
+  const double strata = std::min(1.0, static_cast<double>(summary.shadowed_samples) / options.min_stratum_samples) *
+                        (with_sun ? std::min(1.0, static_cast<double>(summary.sunlit_samples) / options.min_stratum_samples) : 1.0);
+  return fit_quality * strata * summary.inlier_share;
+}
+
+}  // namespace
+
 SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sample>& samples) {
   SunSkyFitSummary summary;
   std::vector<size_t> usable;
@@ -111,138 +271,28 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   }
   const bool with_sun = summary.sunlit_samples > 0;
   const size_t n = usable.size();
-  std::vector<double> spreads;
-  std::vector<double> all_residuals;
-  all_residuals.reserve(3 * n);
   // Two skies (clear-shaped and overcast) when the samples tell them apart, else one.
-  bool two_skies = options.split_sky;
-  if (two_skies) {
-    two_skies = false;
-    for (const size_t i : usable) two_skies = two_skies || samples[i].sky != samples[i].overcast;
-  }
-  std::vector<double> y(n), w(n), relative(n), scratch;
-  std::array<std::vector<double>, 3> x{std::vector<double>(n), std::vector<double>(n), std::vector<double>(n)};
-  scratch.reserve(n);
-  // Medians (start, floor, spread) are taken over every `stride`-th sample: ~2000 of them give each
-  // to well under 1% and cost a quarter of the time.
-  const size_t stride = std::max<size_t>(1, n / 2000);
-  // One channel: E_sun and E_sky, or, with `split`, E_sun, E_clear and E_overcast; else the sky's
-  // regressor is the clear one and the overcast one mixed by `share`. `start`, if given, replaces
-  // the median-based start. Fits the samples `rows`.
-  int unconverged_channels = 0;  // final fits that ran out of IRLS iterations
-  const auto fit_channel = [&](int c, bool split, double share, const ChannelFit* start,
-                               const std::vector<size_t>& rows) {
-    const size_t m = rows.size();
-    std::vector<double>&u = x[0], &v = x[1];
-    for (size_t k = 0; k < m; ++k) {
-      const Sample& s = samples[rows[k]];
-      const double a = s.albedo[c] * glm::one_over_pi<double>();
-      y[k] = s.radiance[c];
-      u[k] = a * s.sun[c];
-      v[k] = split ? a * s.sky[c] : a * ((1.0 - share) * s.sky[c] + share * s.overcast[c]);
-      x[2][k] = split ? a * s.overcast[c] : 0.0;
-    }
-    const std::array<bool, 3> free{with_sun, true, split};
-    // The weighted normal equations of the m samples with the weights in w (all three
-    // regressors; an unused one is zero), vectorised by Eigen.
-    const Eigen::Map<const Eigen::ArrayXd> ey(y.data(), static_cast<Eigen::Index>(m)),
-        ex0(x[0].data(), static_cast<Eigen::Index>(m)), ex1(x[1].data(), static_cast<Eigen::Index>(m)),
-        ex2(x[2].data(), static_cast<Eigen::Index>(m));
-    Eigen::Map<Eigen::ArrayXd> ew(w.data(), static_cast<Eigen::Index>(m));
-    const auto normal_equations = [&] {
-      NormalEquations eq;
-      const Eigen::ArrayXd w0 = ew * ex0, w1 = ew * ex1, w2 = ew * ex2;
-      eq.a[0][0] = (w0 * ex0).sum(), eq.a[0][1] = (w0 * ex1).sum(), eq.a[0][2] = (w0 * ex2).sum();
-      eq.a[1][1] = (w1 * ex1).sum(), eq.a[1][2] = (w1 * ex2).sum(), eq.a[2][2] = (w2 * ex2).sum();
-      eq.b[0] = (w0 * ey).sum(), eq.b[1] = (w1 * ey).sum(), eq.b[2] = (w2 * ey).sum();
-      eq.yy = (ew * ey.square()).sum();
-      eq.a[1][0] = eq.a[0][1], eq.a[2][0] = eq.a[0][2], eq.a[2][1] = eq.a[1][2];
-      return eq;
-    };
-    ChannelFit fit{0.0, 0.0, 0.0};
-    if (start != nullptr) {
-      fit = *start;
-    } else {
-      // Robust start, one sky: the sky from the shadowed samples alone, then the sun from the
-      // sunlit ones.
-      scratch.clear();
-      for (size_t k = 0; k < m; k += stride) {
-        if (!samples[rows[k]].sunlit && v[k] > 0.0) scratch.push_back(y[k] / v[k]);
-      }
-      fit[1] = MedianInPlace(scratch, 0.0);
-      if (scratch.empty()) {
-        ew.setOnes();
-        fit = SolveNonNegative(normal_equations(), {with_sun, true, false});
-      }
-      scratch.clear();
-      for (size_t k = 0; k < m; k += stride) {
-        if (IsSunlit(samples[rows[k]], options)) scratch.push_back((y[k] - v[k] * fit[1]) / u[k]);
-      }
-      if (with_sun && !scratch.empty()) fit[0] = std::max(0.0, MedianInPlace(scratch, 0.0));
-    }
-    const auto predict = [&](size_t k) { return x[0][k] * fit[0] + x[1][k] * fit[1] + x[2][k] * fit[2]; };
-    // IRLS, Cauchy weights on residuals relative to the prediction, floored at a tenth of the
-    // start's median prediction so that near-black points do not dominate.
-    scratch.clear();
-    for (size_t k = 0; k < m; k += stride) scratch.push_back(predict(k));
-    const double floor = std::max(1e-12, 0.1 * MedianInPlace(scratch, 0.0));
-    const double inv_scale = 1.0 / options.cauchy_scale;
-    // Least squares on relative residuals: 1/scale² times the Cauchy weight 1/(1 + r²), that is
-    // 1/(scale² + d²/c²) for a residual d.
-    const auto reweighted = [&] {
-      const Eigen::ArrayXd prediction = ex0 * fit[0] + ex1 * fit[1] + ex2 * fit[2];
-      const Eigen::ArrayXd d = ey - prediction;
-      ew = (prediction.max(floor).square() + d.square() * (inv_scale * inv_scale)).inverse();
-      return normal_equations();
-    };
-    // Until the estimate moves less than `tolerance` (relative). The split only feeds the pooled
-    // overcast share, so it stops sooner.
-    const double tolerance = split ? 1e-3 : 1e-4;
-    bool converged = false;
-    for (int iteration = 0; iteration < options.iterations && !converged; ++iteration) {
-      const ChannelFit next = SolveNonNegative(reweighted(), free);
-      double change = 0.0;
-      const double size = std::max({next[0], next[1] + next[2], 1e-30});
-      for (size_t j = 0; j < 3; ++j) change = std::max(change, std::abs(next[j] - fit[j]) / size);
-      fit = next;
-      converged = change < tolerance;
-    }
-    if (!split && !converged) ++unconverged_channels;
-    for (size_t k = 0; k < m; ++k) {
-      const double prediction = predict(k);
-      relative[k] = (y[k] - prediction) / std::max(prediction, floor);
-    }
-    return fit;
-  };
-  // The overcast share of the sky is one number for all channels (clouds are grey): fitted per
-  // channel (on half the samples), then pooled, then each channel fitted again with it.
-  // Per-channel shares let a small model error in one channel trade sun for sky there.
-  double share = 0.0;
+  bool two_skies = false;
+  for (const size_t i : usable) two_skies = two_skies || (options.split_sky && samples[i].sky != samples[i].overcast);
+  ChannelFitter fitter(options, samples, n, with_sun);
   std::array<ChannelFit, 3> split_fits{};
-  if (two_skies) {
-    // Half the samples are plenty for one number pooled over three channels.
-    std::vector<size_t> every_other;
-    for (size_t k = 0; k < n; k += 2) every_other.push_back(usable[k]);
-    glm::dvec3 clear(0.0), overcast(0.0);
-    for (int c = 0; c < 3; ++c) {
-      split_fits[static_cast<size_t>(c)] = fit_channel(c, true, 0.0, nullptr, every_other);
-      clear[c] = split_fits[static_cast<size_t>(c)][1], overcast[c] = split_fits[static_cast<size_t>(c)][2];
-    }
-    const double sky = glm::compAdd(clear + overcast);
-    share = sky > 0.0 ? glm::compAdd(overcast) / sky : 0.0;
-  }
-  summary.overcast_share = share;
+  summary.overcast_share = two_skies ? PooledOvercastShare(&fitter, usable, &split_fits) : 0.0;
+  // Each channel fitted again with the pooled share, starting from its split fit with the two
+  // skies summed.
+  int unconverged_channels = 0;  // final fits that ran out of IRLS iterations
+  std::vector<double> spreads, all_residuals, scratch;
+  all_residuals.reserve(3 * n);
   for (int c = 0; c < 3; ++c) {
-    // Starting from the split fit, with its two skies summed.
     const ChannelFit& split = split_fits[static_cast<size_t>(c)];
     const ChannelFit start{split[0], split[1] + split[2], 0.0};
-    const ChannelFit fit = fit_channel(c, false, share, two_skies ? &start : nullptr, usable);
+    const ChannelFit fit = fitter.Fit(c, false, summary.overcast_share, two_skies ? &start : nullptr, usable);
+    unconverged_channels += fitter.converged() ? 0 : 1;
     summary.light.sun_rgb[c] = fit[0];
     summary.light.sky_rgb[c] = fit[1];
     scratch.clear();
     for (size_t k = 0; k < n; ++k) {
-      all_residuals.push_back(std::abs(relative[k]));
-      if (k % stride == 0) scratch.push_back(std::abs(relative[k]));
+      all_residuals.push_back(std::abs(fitter.relative()[k]));
+      if (k % fitter.stride() == 0) scratch.push_back(std::abs(fitter.relative()[k]));
     }
     spreads.push_back(1.4826 * MedianInPlace(scratch, 0.0));
   }
@@ -250,12 +300,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   size_t inliers = 0;
   for (const double r : all_residuals) inliers += r < 3.0 * options.cauchy_scale ? 1 : 0;
   summary.inlier_share = static_cast<double>(inliers) / static_cast<double>(all_residuals.size());
-  // Confidence: small robust residuals, and both strata present (sunlit and shadowed samples are
-  // what separates E_sun from E_sky; without sunlit ones E_sun is not observed at all).
-  const double fit_quality = std::exp(-std::pow(summary.residual_spread / options.confident_residual, 2.0));
-  const double strata = std::min(1.0, static_cast<double>(summary.shadowed_samples) / options.min_stratum_samples) *
-                        (with_sun ? std::min(1.0, static_cast<double>(summary.sunlit_samples) / options.min_stratum_samples) : 1.0);
-  summary.confidence = fit_quality * strata * summary.inlier_share;
+  summary.confidence = Confidence(options, summary, with_sun);
   summary.status = unconverged_channels > 0 ? SunSkyFitStatus::kNoConvergence
                    : with_sun                ? SunSkyFitStatus::kConverged
                                              : SunSkyFitStatus::kSkyOnly;
