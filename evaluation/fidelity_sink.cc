@@ -42,6 +42,13 @@ void FidelitySink::Finish(const std::filesystem::path& dir, RunReport* report) c
                           100 * worst_objects->fidelity.object_error, worst_objects->frame));
   report->Say(fmt::format("  their shadows  {:5.1f}% (worst {:.1f}% at frame {})", 100 * shadows,
                           100 * worst_shadows->fidelity.shadow_error, worst_shadows->frame));
+  report->Figure("composite/frames", static_cast<double>(frames_.size()));
+  report->Figure("composite/objects/mean", objects);
+  report->Figure("composite/objects/worst", worst_objects->fidelity.object_error);
+  report->Figure("composite/objects/worst_frame", worst_objects->frame);
+  report->Figure("composite/shadows/mean", shadows);
+  report->Figure("composite/shadows/worst", worst_shadows->fidelity.shadow_error);
+  report->Figure("composite/shadows/worst_frame", worst_shadows->frame);
   WriteCompositeStrip(dir / "worst_vs_truth.png", scene_.intrinsics.width, scene_.intrinsics.height, worst_truth_,
                       worst_composite_, worst_exposure_, scene_.response);
   WriteFileAtomically(dir / "fidelity.csv", FidelityCsv(frames_));

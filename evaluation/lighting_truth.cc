@@ -98,6 +98,13 @@ std::optional<TruthComparison> ReportLighting(const scene::Scene& scene, const s
     line("E_sun", truth->sun_error);
     line("E_sky", truth->sky_error);
     line("sun/sky", truth->ratio_error);
+    report->Figure("lighting/frames", truth->frames);
+    for (int c = 0; c < 3; ++c) {
+      const std::string channel(1, "rgb"[c]);
+      report->Figure("lighting/sun_error/" + channel, truth->sun_error[c]);
+      report->Figure("lighting/sky_error/" + channel, truth->sky_error[c]);
+      report->Figure("lighting/ratio_error/" + channel, truth->ratio_error[c]);
+    }
   }
   PlotEstimates(frames, truth ? &*truth : nullptr, scene.name, png);
   return truth;

@@ -1,20 +1,38 @@
-// The text report of a run (report.txt beside daylit replay's video): each line printed on
-// stdout as it is said, and the whole written atomically at the end.
+// The report of a run: its text (report.txt beside daylit replay's video), each line printed on
+// stdout as it is said, and its figures (figures.json) under stable keys for scripts, such as
+// scripts/results.sh, which fills docs/results.md from them. Both are written atomically.
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <string>
+#include <variant>
+
+#include "pipeline/lighting_pipeline.h"
 
 namespace daylit::evaluation {
 
 class RunReport {
  public:
   void Say(const std::string& line);
+  // A figure under `key` ("fps", "objects/worst"): a number in the unit its key names
+  // (fractions for errors, ms, fps), or a text such as the GL renderer's name.
+  void Figure(const std::string& key, double value) { figures_[key] = value; }
+  void Figure(const std::string& key, const std::string& value) { figures_[key] = value; }
+
   const std::string& text() const { return text_; }
+  // The figures as one JSON object, keys sorted.
+  std::string FiguresJson() const;
   void Write(const std::filesystem::path& file) const;
+  void WriteFigures(const std::filesystem::path& file) const;
 
  private:
   std::string text_;
+  std::map<std::string, std::variant<double, std::string>> figures_;
 };
+
+// A run's speed as figures: frames, seconds, fps (end to end), estimate_ms (median after
+// decoding, frames without a sun move), sun_moves and sun_moves_ms (their total), stage_ms.
+void RunFigures(const pipeline::PipelineRun& run, RunReport* report);
 
 }  // namespace daylit::evaluation

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
+#include "tests/courtyard_fixture.h"
 #include "base/csv.h"
 #include "scene/hdr_image.h"
 #include "scene/scene.h"
@@ -66,6 +67,7 @@ TEST(BakeRecordingTest, AlbedoMatchesGroundTruthAndTheCacheReloads) {
   }
   const double median_error = Median(errors);
   std::printf("per-pixel albedo: median relative error %.1f%% over %zu values\n", 100.0 * median_error, errors.size());
+  testing::RecordFigure("courtyard-a/bake/albedo_median_error", median_error);
   EXPECT_LE(median_error, 0.10);
 
   // An unchanged input loads from the cache, with the same content.

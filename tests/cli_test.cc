@@ -164,8 +164,12 @@ TEST(CliTest, EstimateWritesTheStableCsv) {
   bake::testing::SyntheticRecording rec("cli_estimate");
   const std::string scene = rec.Write().string();
   const fs::path out = rec.dir / "est.csv";
-  const CliRun run = Daylit("estimate " + scene + " --cache " + (rec.dir / "cache").string() + " --out " + out.string());
+  const fs::path figures = rec.dir / "figures.json";
+  const CliRun run = Daylit("estimate " + scene + " --cache " + (rec.dir / "cache").string() + " --out " + out.string() +
+                            " --figures " + figures.string());
   ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::ifstream figures_in(figures);
+  EXPECT_EQ(nlohmann::json::parse(figures_in).at("frames").get<int>(), 1);
   const CsvTable table = ReadCsvFile(out);
   EXPECT_EQ(table.header, (std::vector<std::string>{"frame", "time_utc", "sun_elevation_deg", "sun_azimuth_deg", "sun_r",
                                                      "sun_g", "sun_b", "sky_r", "sky_g", "sky_b", "confidence", "samples"}));
@@ -175,6 +179,28 @@ TEST(CliTest, EstimateWritesTheStableCsv) {
   EXPECT_EQ(ParseFiniteDouble(table.rows[0][4], "sun_r"), 0.0);
   EXPECT_LT(ParseFiniteDouble(table.rows[0][2], "elevation"), 0.0);  // midnight at (0°, 0°)
   EXPECT_TRUE(fs::is_regular_file(rec.dir / "est.png"));
+}
+
+// daylit results fills a template from a folder of figures, and writes nothing when a field
+// names a figure nothing measured.
+TEST(CliTest, ResultsFillsThePageOrNamesTheMissingFigure) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_results_" + std::to_string(::getpid()));
+  fs::create_directories(dir / "measured" / "courtyard-a");
+  WriteFileAtomically(dir / "measured" / "courtyard-a" / "estimate.json", R"({"fps": 176.38, "frames": 600})");
+  WriteFileAtomically(dir / "page.md.in", "estimate: {{courtyard-a/estimate/fps}} fps over {{courtyard-a/estimate/frames}}\n");
+  const std::string measured = (dir / "measured").string();
+  const CliRun run = Daylit("results " + (dir / "page.md.in").string() + " " + measured + " --out " + (dir / "page.md").string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::ifstream page(dir / "page.md");
+  std::string line;
+  std::getline(page, line);
+  EXPECT_EQ(line, "estimate: 176 fps over 600");
+  WriteFileAtomically(dir / "gap.md.in", "{{courtyard-a/replay/fps}}\n");
+  const CliRun gap = Daylit("results " + (dir / "gap.md.in").string() + " " + measured + " --out " + (dir / "gap.md").string());
+  EXPECT_EQ(gap.exit_code, 2);
+  EXPECT_NE(gap.err.find("gap.md.in:1: nothing measured \"courtyard-a/replay/fps\""), std::string::npos) << gap.err;
+  EXPECT_FALSE(fs::exists(dir / "gap.md"));
+  fs::remove_all(dir);
 }
 
 TEST(CliTest, EstimateSkipsAFrameThatCannotBeDecodedAndGoesOn) {
@@ -397,12 +423,21 @@ TEST(CliTest, ReplayWritesTheAugmentedVideoAndItsReport) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("60 frames in"), std::string::npos) << run.out;
   EXPECT_NE(run.err.find("replay 100%"), std::string::npos) << "progress";
-  for (const char* name : {"r.mp4", "estimates.csv", "lighting.png", "report.txt", "fidelity.csv", "fidelity.png", "worst_vs_truth.png"}) {
+  for (const char* name : {"r.mp4", "estimates.csv", "lighting.png", "report.txt", "figures.json", "fidelity.csv",
+                           "fidelity.png", "worst_vs_truth.png"}) {
     EXPECT_TRUE(fs::is_regular_file(dir / name)) << name;
   }
   size_t files = 0;
   for (const auto& entry : fs::directory_iterator(dir)) files += entry.is_regular_file() ? 1 : 0;
-  EXPECT_EQ(files, 7u) << "a temporary file was left behind";
+  EXPECT_EQ(files, 8u) << "a temporary file was left behind";
+  // The report's figures for scripts (docs/results.md): the run and the composite's truth frames.
+  std::ifstream figures_in(dir / "figures.json");
+  const nlohmann::json figures = nlohmann::json::parse(figures_in);
+  EXPECT_EQ(figures.at("frames").get<int>(), 60);
+  EXPECT_EQ(figures.at("composite/frames").get<int>(), 2);
+  EXPECT_GT(figures.at("fps").get<double>(), 0.0);
+  EXPECT_LT(figures.at("composite/objects/worst").get<double>(), 0.10);
+  EXPECT_NE(figures.at("gl_renderer").get<std::string>(), "");
   EXPECT_EQ(ReadCsvFile(dir / "estimates.csv").rows.size(), 60u);
   // Frames 40 and 50 against the truth: the issue's bar is 10% on the objects and their shadows.
   const CsvTable fidelity = ReadCsvFile(dir / "fidelity.csv");

@@ -2,6 +2,11 @@
 // per test binary, the bake from one cache in the build tree that the tests share.
 #pragma once
 
+#include <string>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
 #include "bake/bake.h"
 #include "base/log.h"
 #include "scene/scene.h"
@@ -22,6 +27,12 @@ inline const BundledCourtyard& Courtyard() {
     return c;
   }();
   return courtyard;
+}
+
+// A measured figure under `key` ("courtyard-a/volume/p95_error"), in gtest's output for
+// scripts/results.sh to put on docs/results.md: fractions for errors, seconds for times.
+inline void RecordFigure(const std::string& key, double value) {
+  ::testing::Test::RecordProperty(key, fmt::format("{}", value));
 }
 
 }  // namespace daylit::testing

@@ -102,6 +102,7 @@ TEST(ObjectShadowsRecordingTest, ShadowsAndSkyLossMatchThePathTracer) {
     worst = std::max(worst, f.mean_error);
     ++frames;
   }
+  testing::RecordFigure("courtyard-a/object_shadows/worst_error", worst);
   EXPECT_EQ(frames, 12);
   EXPECT_LT(worst, 0.09);  // measured 2.7-7.1% per frame
 }

@@ -4,6 +4,9 @@
 // of the model's surfaces, and the sky's DHI within 5%. Two clear and two cloudy frames.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include <cstdio>
 
 #include <fmt/format.h>
@@ -23,6 +26,7 @@ TEST(RelightEnvRecordingTest, RelitMapsMatchThePathTracedOnes) {
   const bake::SceneBake& baked = testing::Courtyard().bake;
   const scene::RayCaster caster(scene.model);
   relight::EnvRelighter relighter(baked, glm::vec3(scene.envmap->position), caster);
+  double worst_surface = 0.0, worst_sky = 0.0;
   for (const int frame : {300, 347, 550, 598}) {
     const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, static_cast<size_t>(frame), {});
     relighter.SetSun(fit.sun_dir);
@@ -36,7 +40,11 @@ TEST(RelightEnvRecordingTest, RelitMapsMatchThePathTracedOnes) {
     EXPECT_GT(cmp.surface_texels, 300000u);
     EXPECT_LE(cmp.surface_error, 0.10) << frame;
     EXPECT_NEAR(cmp.sky_dhi / cmp.true_sky_dhi, 1.0, 0.05) << frame;
+    worst_surface = std::max(worst_surface, cmp.surface_error);
+    worst_sky = std::max(worst_sky, std::abs(cmp.sky_dhi / cmp.true_sky_dhi - 1.0));
   }
+  testing::RecordFigure("courtyard-a/env/surface_error/worst", worst_surface);
+  testing::RecordFigure("courtyard-a/env/sky_dhi_error/worst", worst_sky);
 }
 
 }  // namespace

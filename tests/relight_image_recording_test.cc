@@ -55,6 +55,8 @@ TEST(RelightImageRecordingTest, AFrameRelitToAnotherTimeMatchesTheRealFrame) {
   const double iou_before = relight::ShadowIoU(layout(from.linear), layout(to.linear));
   std::printf("frame 152 relit to frame 452: %.1f%% (unrelit %.1f%%), shadow IoU %.3f (unrelit %.3f), %zu of %zu pixels floored\n",
               100 * error, 100 * before, iou, iou_before, stats.clamped, stats.model_pixels);
+  testing::RecordFigure("courtyard-a/image_relight/error", error);
+  testing::RecordFigure("courtyard-a/image_relight/shadow_iou", iou);
   EXPECT_LE(error, 0.10);
   EXPECT_GE(iou, 0.90);
   // The measures can fail: the frame as it was is far off on both.

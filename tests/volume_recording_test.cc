@@ -75,8 +75,9 @@ TEST(VolumeRecordingTest, CourtyardVolumeMatchesBruteForceIrradiance) {
   for (const double e : errors) mean += e / static_cast<double>(errors.size());
   std::sort(errors.begin(), errors.end());
   const double p95 = errors[949];
-  RecordProperty("mean_error", std::to_string(mean));
-  RecordProperty("p95_error", std::to_string(p95));
+  testing::RecordFigure("courtyard-a/volume/mean_error", mean);
+  testing::RecordFigure("courtyard-a/volume/p95_error", p95);
+  testing::RecordFigure("courtyard-a/volume/max_error", errors.back());
   std::printf("volume vs brute force at 1000 points: mean %.2f%%, 95th percentile %.2f%%, max %.2f%% (%zu probes inside the model)\n",
               100 * mean, 100 * p95, 100 * errors.back(), volume.InsideCount());
   EXPECT_LE(mean, 0.03);

@@ -21,6 +21,7 @@ void AddRenderCommand(CLI::App& app);
 void AddReplayCommand(CLI::App& app);
 void AddRelightCommand(CLI::App& app);
 void AddLiveCommand(CLI::App& app);
+void AddResultsCommand(CLI::App& app);
 
 // --lighting volume|lights:N, for the commands that render the objects (render::ParseLighting).
 void AddLightingOption(CLI::App* cmd, std::string* lighting);

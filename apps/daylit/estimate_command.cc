@@ -23,11 +23,15 @@ struct EstimateCommandOptions {
   std::string cache;
   std::string out = "estimates.csv";
   std::string plot;
+  std::string figures;
   pipeline::LightingPipelineOptions pipeline;
 };
 
 void RunEstimateCommand(const EstimateCommandOptions& o) {
   if (const std::string why = o.pipeline.Check(); !why.empty()) ThrowInputError("options: {}", why);
+  if (!o.figures.empty() && std::filesystem::path(o.figures).extension() != ".json") {
+    ThrowInputError("--figures: {} must end in .json", o.figures);
+  }
   const scene::Scene scene = scene::LoadScene(o.recording);
   // The frames first: a camera that is not there is an error now, not after the bake.
   std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
@@ -47,7 +51,9 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   for (const double ms : run.sun_moves_ms) moves_ms += ms;
   const std::string plot = o.plot.empty() ? std::filesystem::path(o.out).replace_extension(".png").string() : o.plot;
   evaluation::RunReport report;
+  evaluation::RunFigures(run, &report);
   evaluation::ReportLighting(scene, run.frames, o.out, plot, &report);
+  if (!o.figures.empty()) report.WriteFigures(o.figures);
   Log().info("{} frames in {:.2f} s ({:.0f} fps end to end); estimation after decoding {:.2f} ms per frame (median), "
              "plus {} sun moves taking {:.0f} ms in all; wrote {} and {}",
              n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9), run.median_estimate_ms,
@@ -67,6 +73,8 @@ void AddEstimateCommand(CLI::App& app) {
   cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
   cmd->add_option("--out", options->out, "Estimates CSV (default estimates.csv)");
   cmd->add_option("--plot", options->plot, "Plot PNG (default: the CSV's name with .png)");
+  cmd->add_option("--figures", options->figures,
+                  "Also write the run's figures as JSON (fps, ms per frame, errors against the truth; docs/results.md)");
   cmd->add_option("--samples", options->pipeline.estimator.sampler.samples, "Samples per frame (default 8000)")
       ->check(CLI::Range(100, 1000000));
   cmd->add_option("--frames", options->pipeline.max_frames, "Stop after this many frames (a live camera runs until Ctrl-C)")

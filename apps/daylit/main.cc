@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   daylit::app::AddReplayCommand(app);
   daylit::app::AddRelightCommand(app);
   daylit::app::AddLiveCommand(app);
+  daylit::app::AddResultsCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -47,9 +47,12 @@ struct ReplayOptions {
 
 // report.txt (also on stdout), estimates.csv, lighting.png and, with truth, the fidelity files.
 void WriteReplayReport(const scene::Scene& scene, const pipeline::PipelineRun& run, const render::FrameRenderer& renderer,
-                       const evaluation::FidelitySink& fidelity, bool live, const fs::path& dir) {
+                       const evaluation::FidelitySink& fidelity, bool live, const std::string& gl_renderer,
+                       const fs::path& dir) {
   const size_t n = run.frames.size();
   evaluation::RunReport report;
+  evaluation::RunFigures(run, &report);
+  if (!gl_renderer.empty()) report.Figure("gl_renderer", gl_renderer);
   if (run.undecodable > 0 && live) Log().warn("{} frames could not be read from the camera", run.undecodable);
   report.Say(fmt::format("{}: {} frames in {:.1f} s, {:.1f} fps end to end (decode, estimate, relight, render, encode)",
                          scene.name, n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9)));
@@ -60,10 +63,12 @@ void WriteReplayReport(const scene::Scene& scene, const pipeline::PipelineRun& r
     report.Say(fmt::format("  the objects lit by the sun and {} lights, their directions fitted {} times (sun moves and "
                            "large changes of the light; {} stopped at the iteration limit)",
                            lights->count(), lights->generation(), lights->unconverged_fits()));
+    report.Figure("lights/fits", lights->generation());
   }
   evaluation::ReportLighting(scene, run.frames, dir / "estimates.csv", dir / "lighting.png", &report);
   fidelity.Finish(dir, &report);
   report.Write(dir / "report.txt");
+  report.WriteFigures(dir / "figures.json");
 }
 
 void RunReplay(const ReplayOptions& o) {
@@ -122,8 +127,8 @@ void RunReplay(const ReplayOptions& o) {
   const pipeline::PipelineRun run = lighting.Run(std::move(source));
   if (video) video->Commit();
   if (!o.screenshot.empty()) report::WritePng(o.screenshot, {window->Screenshot()});
-  WriteReplayReport(scene, run, renderer, fidelity, o.live, dir);
-  Log().info("wrote {}estimates.csv, lighting.png, report.txt{} in {}", video ? out.filename().string() + ", " : "",
+  WriteReplayReport(scene, run, renderer, fidelity, o.live, gl ? gl->renderer() : std::string(), dir);
+  Log().info("wrote {}estimates.csv, lighting.png, report.txt, figures.json{} in {}", video ? out.filename().string() + ", " : "",
              fidelity.frames().empty() ? "" : ", fidelity.csv, fidelity.png, worst_vs_truth.png", dir.string());
 }
 

@@ -1,0 +1,183 @@
+#include "evaluation/results_page.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "base/error.h"
+
+namespace daylit::evaluation {
+namespace {
+
+// Seconds per the time unit Google Benchmark writes.
+double SecondsPer(const std::string& time_unit, const std::string& source) {
+  if (time_unit == "ns") return 1e-9;
+  if (time_unit == "us") return 1e-6;
+  if (time_unit == "ms") return 1e-3;
+  if (time_unit == "s") return 1.0;
+  ThrowInputError("{}: time_unit \"{}\" is not ns, us, ms or s", source, time_unit);
+}
+
+// A text that is a whole number ("0.043", "-2e-3"), as a number.
+bool ParseNumber(const std::string& text, double* value) {
+  if (text.empty()) return false;
+  char* end = nullptr;
+  *value = std::strtod(text.c_str(), &end);
+  return end == text.c_str() + text.size() && std::isfinite(*value);
+}
+
+// A run's name without what Google Benchmark appends for how it ran ("/iterations:3",
+// "/real_time", "/repeats:3", ...): BM_FirstSun/iterations:3/real_time is BM_FirstSun.
+std::string FamilyAndArguments(const std::string& run_name) {
+  static const char* kHowItRan[] = {"iterations:", "repeats:", "threads:", "min_time:", "min_warmup_time:",
+                                    "real_time", "process_time", "manual_time"};
+  std::string name;
+  size_t at = 0;
+  while (at <= run_name.size()) {
+    const size_t slash = std::min(run_name.find('/', at), run_name.size());
+    const std::string part = run_name.substr(at, slash - at);
+    const bool how = std::any_of(std::begin(kHowItRan), std::end(kHowItRan),
+                                 [&](const char* prefix) { return part.rfind(prefix, 0) == 0; });
+    if (!how) name += (name.empty() ? "" : "/") + part;
+    at = slash + 1;
+  }
+  return name;
+}
+
+}  // namespace
+
+void AddBenchmarkFigures(const nlohmann::json& json, const std::string& source, MeasuredFigures* figures) {
+  if (!json.is_object() || !json.contains("benchmarks") || !json["benchmarks"].is_array()) {
+    ThrowInputError("{}: not Google Benchmark's JSON output (no \"benchmarks\" array)", source);
+  }
+  static const std::set<std::string> kNotCounters = {"family_index", "per_family_instance_index", "repetitions",
+                                                     "repetition_index", "threads", "iterations"};
+  // Runs first, then the medians of repeated runs over them.
+  for (const bool medians : {false, true}) {
+    for (const nlohmann::json& run : json["benchmarks"]) {
+      const bool aggregate = run.value("run_type", "iteration") == "aggregate";
+      if (aggregate != medians || (aggregate && run.value("aggregate_name", "") != "median")) continue;
+      if (!run.contains("name") || !run.contains("time_unit")) ThrowInputError("{}: a benchmark without name or time_unit", source);
+      const std::string name = FamilyAndArguments(run.value("run_name", run["name"].get<std::string>()));
+      const double unit = SecondsPer(run["time_unit"].get<std::string>(), source);
+      for (const auto& [field, value] : run.items()) {
+        if (!value.is_number() || kNotCounters.count(field) > 0) continue;
+        const bool time = field == "real_time" || field == "cpu_time";
+        figures->numbers["bench/" + name + "/" + field] = value.get<double>() * (time ? unit : 1.0);
+      }
+    }
+  }
+}
+
+void AddTestFigures(const nlohmann::json& json, const std::string& source, MeasuredFigures* figures) {
+  if (!json.is_object() || !json.contains("testsuites") || !json["testsuites"].is_array()) {
+    ThrowInputError("{}: not gtest's JSON output (no \"testsuites\" array)", source);
+  }
+  for (const nlohmann::json& suite : json["testsuites"]) {
+    for (const nlohmann::json& test : suite.value("testsuite", nlohmann::json::array())) {
+      for (const auto& [key, value] : test.items()) {
+        if (key.find('/') == std::string::npos || !value.is_string()) continue;
+        double number = 0.0;
+        if (ParseNumber(value.get<std::string>(), &number)) {
+          figures->numbers["test/" + key] = number;
+        } else {
+          figures->texts["test/" + key] = value.get<std::string>();
+        }
+      }
+    }
+  }
+}
+
+void AddRunFigures(const nlohmann::json& json, const std::string& prefix, const std::string& source,
+                   MeasuredFigures* figures) {
+  if (!json.is_object()) ThrowInputError("{}: figures are a JSON object of numbers and texts", source);
+  for (const auto& [key, value] : json.items()) {
+    if (value.is_number()) {
+      figures->numbers[prefix + "/" + key] = value.get<double>();
+    } else if (value.is_string()) {
+      figures->texts[prefix + "/" + key] = value.get<std::string>();
+    } else {
+      ThrowInputError("{}: \"{}\" is neither a number nor a text", source, key);
+    }
+  }
+}
+
+MeasuredFigures LoadMeasuredFigures(const std::filesystem::path& folder) {
+  if (!std::filesystem::is_directory(folder)) ThrowInputError("{}: not a folder of measured figures", folder.string());
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(folder)) {
+    if (entry.is_regular_file() && entry.path().extension() == ".json") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  MeasuredFigures figures;
+  for (const std::filesystem::path& file : files) {
+    std::ifstream in(file);
+    nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+    if (json.is_discarded()) ThrowInputError("{}: not JSON", file.string());
+    if (json.contains("benchmarks")) {
+      AddBenchmarkFigures(json, file.string(), &figures);
+    } else if (json.contains("testsuites")) {
+      AddTestFigures(json, file.string(), &figures);
+    } else {
+      std::filesystem::path prefix = file.lexically_relative(folder).replace_extension();
+      if (prefix.filename() == "figures") prefix = prefix.parent_path();
+      AddRunFigures(json, prefix.generic_string(), file.string(), &figures);
+    }
+  }
+  return figures;
+}
+
+std::string FormatFigure(double value, const std::string& unit) {
+  static const std::map<std::string, double> kScale = {{"", 1.0}, {"s", 1.0},  {"ms", 1e3}, {"us", 1e6},
+                                                        {"%", 1e2}, {"k", 1e-3}, {"M", 1e-6}};
+  const auto scale = kScale.find(unit);
+  if (scale == kScale.end() && unit != "/s") ThrowInputError("unit \"{}\" is not one of s, ms, us, /s, %, k, M", unit);
+  const double v = unit == "/s" ? 1.0 / value : value * scale->second;
+  if (v == 0.0 || !std::isfinite(v)) return fmt::format("{}", v);
+  const int magnitude = static_cast<int>(std::floor(std::log10(std::abs(v))));
+  if (magnitude >= 2) {
+    const double step = std::pow(10.0, magnitude - 2);
+    return fmt::format("{:.0f}", std::round(v / step) * step);
+  }
+  return fmt::format("{:.{}f}", v, 2 - magnitude);
+}
+
+std::string FillResultsPage(const std::string& page_template, const std::string& template_name,
+                            const MeasuredFigures& figures) {
+  std::string page;
+  size_t at = 0;
+  while (true) {
+    const size_t open = page_template.find("{{", at);
+    if (open == std::string::npos) break;
+    const size_t close = page_template.find("}}", open);
+    const int line = 1 + static_cast<int>(std::count(page_template.begin(), page_template.begin() + open, '\n'));
+    if (close == std::string::npos) ThrowInputError("{}:{}: a field opened with {{{{ is not closed", template_name, line);
+    page.append(page_template, at, open - at);
+    const std::string field = page_template.substr(open + 2, close - open - 2);
+    const size_t bar = field.find('|');
+    const std::string key = field.substr(0, bar);
+    const std::string unit = bar == std::string::npos ? "" : field.substr(bar + 1);
+    if (const auto number = figures.numbers.find(key); number != figures.numbers.end()) {
+      try {
+        page += FormatFigure(number->second, unit);
+      } catch (const InputError& e) {
+        ThrowInputError("{}:{}: {}: {}", template_name, line, key, e.what());
+      }
+    } else if (const auto text = figures.texts.find(key); text != figures.texts.end() && unit.empty()) {
+      page += text->second;
+    } else {
+      ThrowInputError("{}:{}: nothing measured \"{}\"{}", template_name, line, key,
+                      text != figures.texts.end() ? " as a number" : "");
+    }
+    at = close + 2;
+  }
+  page.append(page_template, at, std::string::npos);
+  return page;
+}
+
+}  // namespace daylit::evaluation

@@ -1,0 +1,88 @@
+#include "evaluation/results_page.h"
+
+#include <gtest/gtest.h>
+
+#include "base/error.h"
+
+namespace daylit::evaluation {
+namespace {
+
+// As Google Benchmark 1.7 writes it with --benchmark_repetitions=3 --benchmark_report_aggregates_only.
+const char* kBenchmarkJson = R"({
+  "context": {"num_cpus": 2},
+  "benchmarks": [
+    {"name": "BM_EstimateFrame_mean", "run_name": "BM_EstimateFrame", "run_type": "aggregate",
+     "aggregate_name": "mean", "iterations": 3, "real_time": 1700.0, "cpu_time": 1690.0, "time_unit": "us"},
+    {"name": "BM_EstimateFrame_median", "run_name": "BM_EstimateFrame", "run_type": "aggregate",
+     "aggregate_name": "median", "iterations": 3, "real_time": 1523.4, "cpu_time": 1500.0, "time_unit": "us",
+     "items_per_second": 656.4},
+    {"name": "BM_FirstSun/iterations:3/real_time", "run_name": "BM_FirstSun/iterations:3/real_time",
+     "run_type": "iteration", "iterations": 3, "real_time": 0.43, "cpu_time": 0.8, "time_unit": "s"},
+    {"name": "BM_RenderFrame/8/real_time", "run_name": "BM_RenderFrame/8/real_time",
+     "run_type": "iteration", "iterations": 40, "real_time": 17.0, "cpu_time": 17.0, "time_unit": "ms"},
+    {"name": "BM_Draw", "run_name": "BM_Draw", "run_type": "iteration", "repetitions": 1,
+     "iterations": 3800, "real_time": 0.18, "cpu_time": 0.18, "time_unit": "ms"}
+  ]})";
+
+const char* kGtestJson = R"({
+  "testsuites": [{"name": "EstimateRecording", "testsuite": [
+    {"name": "EveryBurst", "status": "RUN", "time": "12s",
+     "courtyard-a/burst0/sky_error/r": "0.0213", "courtyard-a/worst_surface": "pillar_2"}]}]})";
+
+MeasuredFigures Figures() {
+  MeasuredFigures figures;
+  AddBenchmarkFigures(nlohmann::json::parse(kBenchmarkJson), "estimate_bench.json", &figures);
+  AddTestFigures(nlohmann::json::parse(kGtestJson), "estimate_recording_test.json", &figures);
+  AddRunFigures(nlohmann::json::parse(R"json({"fps": 41.23, "gl_renderer": "llvmpipe (LLVM 15.0.6, 256 bits)"})json"),
+                "courtyard-a/replay", "figures.json", &figures);
+  return figures;
+}
+
+TEST(ResultsPage, MediansOfRepetitionsInSeconds) {
+  const MeasuredFigures figures = Figures();
+  EXPECT_DOUBLE_EQ(figures.numbers.at("bench/BM_EstimateFrame/real_time"), 1523.4e-6);  // the median, not the mean
+  EXPECT_DOUBLE_EQ(figures.numbers.at("bench/BM_EstimateFrame/items_per_second"), 656.4);
+  EXPECT_DOUBLE_EQ(figures.numbers.at("bench/BM_Draw/cpu_time"), 0.18e-3);
+  EXPECT_EQ(figures.numbers.count("bench/BM_Draw/iterations"), 0u);
+  // How a run ran is not part of its key; its arguments are.
+  EXPECT_DOUBLE_EQ(figures.numbers.at("bench/BM_FirstSun/real_time"), 0.43);
+  EXPECT_DOUBLE_EQ(figures.numbers.at("bench/BM_RenderFrame/8/real_time"), 17.0e-3);
+}
+
+TEST(ResultsPage, FillsFieldsInTheirUnits) {
+  const std::string page = FillResultsPage(
+      "| frame | {{bench/BM_EstimateFrame/real_time|ms}} ms |\n"
+      "sky {{test/courtyard-a/burst0/sky_error/r|%}}%, worst {{test/courtyard-a/worst_surface}}, "
+      "{{courtyard-a/replay/fps}} fps on {{courtyard-a/replay/gl_renderer}}; draw {{bench/BM_Draw/real_time|us}} us\n",
+      "results.md.in", Figures());
+  EXPECT_EQ(page,
+            "| frame | 1.52 ms |\n"
+            "sky 2.13%, worst pillar_2, 41.2 fps on llvmpipe (LLVM 15.0.6, 256 bits); draw 180 us\n");
+}
+
+TEST(ResultsPage, ThreeSignificantDigits) {
+  EXPECT_EQ(FormatFigure(25123.0, "k"), "25.1");
+  EXPECT_EQ(FormatFigure(25123.0, ""), "25100");
+  EXPECT_EQ(FormatFigure(0.0123456, ""), "0.0123");
+  EXPECT_EQ(FormatFigure(0.1, "%"), "10.0");
+  EXPECT_EQ(FormatFigure(0.0, "ms"), "0");
+  EXPECT_EQ(FormatFigure(3.8e-3, "/s"), "263");  // a frame's decoding time as frames per second
+  EXPECT_THROW(FormatFigure(1.0, "hours"), InputError);
+}
+
+TEST(ResultsPage, NamesTheFieldNothingMeasured) {
+  try {
+    FillResultsPage("line one\n{{bench/BM_Gone/real_time|ms}}\n", "results.md.in", Figures());
+    FAIL() << "filled a field nothing measured";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "results.md.in:2: nothing measured \"bench/BM_Gone/real_time\"");
+  }
+  // A text where a number belongs, an unclosed field, a unit nobody knows.
+  EXPECT_THROW(FillResultsPage("{{test/courtyard-a/worst_surface|%}}", "t", Figures()), InputError);
+  EXPECT_THROW(FillResultsPage("{{courtyard-a/replay/fps|ms", "t", Figures()), InputError);
+  EXPECT_THROW(FillResultsPage("{{courtyard-a/replay/fps|days}}", "t", Figures()), InputError);
+  EXPECT_THROW(AddBenchmarkFigures(nlohmann::json::parse(kGtestJson), "x.json", nullptr), InputError);
+}
+
+}  // namespace
+}  // namespace daylit::evaluation

@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Measures every figure of docs/results.md and writes the page again from docs/results.md.in:
+#   - every Google Benchmark target in bench/ (median of 3 repetitions),
+#   - the recording tests, whose figures gtest writes as JSON (tests/courtyard_fixture.h's
+#     RecordFigure),
+#   - daylit estimate and daylit replay of each bundled recording (their figures.json),
+#   - the machine (cores, CPU, memory, compiler; the GL renderer from the replay).
+# The raw JSON stays in build/results/. Run on an idle machine: about 25 minutes on 2 cores.
+# `daylit results` refuses to write the page if any field of the template was not measured.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/build.sh >/dev/null
+daylit=build/bin/daylit
+out=build/results
+rm -rf "$out"
+mkdir -p "$out/bench" "$out/tests"
+export MESA_SHADER_CACHE_DIR="$PWD/build/mesa-cache"
+
+json_text() { sed 's/\\/\\\\/g; s/"/\\"/g' <<<"$1"; }
+{
+  printf '{\n'
+  printf '  "cores": %s,\n' "$(nproc)"
+  printf '  "cpu": "%s",\n' "$(json_text "$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)")"
+  printf '  "memory_gib": %s,\n' "$(awk '/^MemTotal/ { printf "%.0f", $2 / 1048576 }' /proc/meminfo)"
+  printf '  "os": "%s",\n' "$(json_text "$(. /etc/os-release && echo "$PRETTY_NAME")")"
+  printf '  "compiler": "%s"\n' "$(json_text "$(c++ --version | head -n 1)")"
+  printf '}\n'
+} >"$out/machine.json"
+
+for bench in build/bin/*_bench; do
+  name=$(basename "$bench")
+  echo "results: $name" >&2
+  "$bench" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
+    --benchmark_out="$out/bench/$name.json" --benchmark_out_format=json >/dev/null
+done
+
+for test in build/tests/*_recording_test; do
+  name=$(basename "$test")
+  echo "results: $name" >&2
+  "$test" --gtest_output="json:$out/tests/$name.json" >/dev/null
+done
+
+for recording in recordings/*/; do
+  name=$(basename "$recording")
+  echo "results: daylit estimate and replay of $name" >&2
+  mkdir -p "$out/$name/replay"
+  "$daylit" -q estimate "$recording" --cache "build/results-cache/$name" --out "$out/$name/estimates.csv" \
+    --figures "$out/$name/estimate.json" >/dev/null
+  "$daylit" -q replay "$recording" --cache "build/results-cache/$name" --out "$out/$name/replay/replay.mp4" >/dev/null
+done
+
+"$daylit" results docs/results.md.in "$out" --out docs/results.md
