@@ -15,7 +15,7 @@
 #include "base/options_check.h"
 #include "base/statistics.h"
 #include "base/log.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 #include "scene/raycaster.h"
 
 namespace daylit::bake {
@@ -68,7 +68,7 @@ HiddenSurfaceModel SurfaceModelFrom(const scene::SceneModel& model, const std::v
 }
 
 EnvMapMaps ComputeEnvMapMaps(const scene::Scene& scene, const scene::RayCaster& caster, const BakeOptions& options,
-                             scene::HdrImage* env, CaptureSun* sun) {
+                             HdrImage* env, CaptureSun* sun) {
   const std::string name = scene.envmap->file.string();
   scene::CheckEnvMap(*env, name);
   *sun = ExtractSun(env, SunAtCapture(scene), scene.envmap->sun_irradiance_rgb, name);
@@ -79,7 +79,7 @@ EnvMapMaps ComputeEnvMapMaps(const scene::Scene& scene, const scene::RayCaster& 
   const glm::vec3 capture(scene.envmap->position);
   std::vector<glm::vec3> origins(n, capture), dirs(n);
   for (size_t t = 0; t < n; ++t) {
-    dirs[t] = glm::vec3(scene::LatLongDirection(static_cast<double>(t % maps.width), static_cast<double>(t / maps.width), maps.width, maps.height));
+    dirs[t] = glm::vec3(LatLongDirection(static_cast<double>(t % maps.width), static_cast<double>(t / maps.width), maps.width, maps.height));
   }
   std::vector<scene::RayHit> hits(n);
   caster.IntersectMany(origins.data(), dirs.data(), n, 0.0f, hits.data());
@@ -107,7 +107,7 @@ EnvMapMaps ComputeEnvMapMaps(const scene::Scene& scene, const scene::RayCaster& 
     maps.surface[t] = hits[t].surface;
     surface_texels.push_back(t);
   }
-  const scene::HdrImage sky = SkyOnly(*env, is_sky, sun->dir);
+  const HdrImage sky = SkyOnly(*env, is_sky, sun->dir);
   std::vector<float> env_distance(n, -1.0f);
   for (size_t t = 0; t < n; ++t) env_distance[t] = hits[t].IsHit() ? hits[t].t : -1.0f;
   std::vector<glm::vec3> points(surface_texels.size()), normals(surface_texels.size()), e(surface_texels.size()),
@@ -181,7 +181,7 @@ glm::vec3 EnvAlbedoAt(const EnvMapMaps& env, const glm::dvec2& uv, uint32_t surf
     }
   }
   if (weight > 1e-9) return glm::vec3(sum / weight);
-  const int t = scene::LatLongTexel(scene::LatLongDirection(uv.x, uv.y, env.width, env.height), env.width, env.height);
+  const int t = LatLongTexel(LatLongDirection(uv.x, uv.y, env.width, env.height), env.width, env.height);
   return env.albedo[static_cast<size_t>(t)];
 }
 
@@ -248,8 +248,8 @@ CameraGBuffer ComputeCameraGBuffer(const scene::Scene& scene, const scene::RayCa
     g.sky_visibility[i] = v[k];
     const glm::dvec3 toward = glm::dvec3(points[k]) - glm::dvec3(capture);
     if (seen[k]) {
-      const glm::dvec2 uv = scene::LatLongCoordinates(toward, env.width, env.height);
-      g.env_texel[i] = static_cast<uint32_t>(scene::LatLongTexel(toward, env.width, env.height));
+      const glm::dvec2 uv = LatLongCoordinates(toward, env.width, env.height);
+      g.env_texel[i] = static_cast<uint32_t>(LatLongTexel(toward, env.width, env.height));
       g.albedo[i] = EnvAlbedoAt(env, uv, g.surface[i]) * detail[i];
     } else {
       g.albedo[i] = albedo_table[g.surface[i]].albedo * detail[i];
@@ -280,9 +280,9 @@ glm::vec3 GatherOrigin(const scene::RayCaster& caster, const glm::vec3& probe) {
   return probe;
 }
 
-GatherTables ComputeGatherTables(const scene::Scene& scene, const scene::RayCaster& caster, const BakeOptions& options,
+sh::GatherTables ComputeGatherTables(const scene::Scene& scene, const scene::RayCaster& caster, const BakeOptions& options,
                                  const EnvMapMaps& env) {
-  GatherTables gather;
+  sh::GatherTables gather;
   if (!scene.volume) return gather;
   gather.min = glm::vec3(scene.volume->min);
   gather.max = glm::vec3(scene.volume->max);
@@ -310,7 +310,7 @@ GatherTables ComputeGatherTables(const scene::Scene& scene, const scene::RayCast
   for (size_t r = 0; r < n; ++r) {
     // Parallax: the texel that shows the hit point from the capture position; sky straight.
     const glm::dvec3 toward = hits[r].IsHit() ? glm::dvec3(origins[r] + hits[r].t * rays[r]) - capture : glm::dvec3(rays[r]);
-    gather.texel[r] = static_cast<uint32_t>(scene::LatLongTexel(toward, env.width, env.height));
+    gather.texel[r] = static_cast<uint32_t>(LatLongTexel(toward, env.width, env.height));
   }
   return gather;
 }
@@ -342,15 +342,6 @@ size_t CameraGBuffer::DiffuseCount() const {
   return static_cast<size_t>(std::count(diffuse.begin(), diffuse.end(), uint8_t{1}));
 }
 
-glm::vec3 GatherTables::ProbePosition(int i, int j, int k) const {
-  const glm::ivec3 index(i, j, k);
-  glm::vec3 p;
-  for (int a = 0; a < 3; ++a) {
-    p[a] = resolution[a] <= 1 ? 0.5f * (min[a] + max[a])
-                              : min[a] + (max[a] - min[a]) * static_cast<float>(index[a]) / static_cast<float>(resolution[a] - 1);
-  }
-  return p;
-}
 
 SceneBake RunBake(const scene::Scene& scene, const BakeOptions& options) {
   if (!scene.envmap) ThrowInputError("{}: envmap: missing (the bake needs the HDR environment map)", scene.file.string());
@@ -362,7 +353,7 @@ SceneBake RunBake(const scene::Scene& scene, const BakeOptions& options) {
     Log().warn("{}: {} degenerate triangles (zero area) left out of ray casting", scene.model.file.string(),
                caster.degenerate_triangles());
   }
-  scene::HdrImage env = scene::ReadHdrImage(scene.envmap->file);
+  HdrImage env = scene::ReadHdrImage(scene.envmap->file);
   bake.env = ComputeEnvMapMaps(scene, caster, options, &env, &bake.capture_sun);
   bake.albedo_table = AlbedoTable(scene.model, bake.env);
   bake.camera = ComputeCameraGBuffer(scene, caster, options, bake.env, bake.albedo_table, LoadDiffuseMask(scene, bake.env));
@@ -372,6 +363,34 @@ SceneBake RunBake(const scene::Scene& scene, const BakeOptions& options) {
   }
   bake.gather = ComputeGatherTables(scene, caster, options, bake.env);
   return bake;
+}
+
+std::vector<uint8_t> ProbesInsideModel(const sh::GatherTables& gather, const scene::RayCaster& caster) {
+  const size_t dirs = gather.directions.size();
+  const size_t probes = gather.ProbeCount();
+  std::vector<glm::vec3> origins(probes * dirs), rays(probes * dirs);
+  const glm::ivec3 n = gather.resolution;
+  for (int k = 0; k < n.z; ++k) {
+    for (int j = 0; j < n.y; ++j) {
+      for (int i = 0; i < n.x; ++i) {
+        const size_t p = (static_cast<size_t>(k) * n.y + j) * n.x + i;
+        for (size_t d = 0; d < dirs; ++d) origins[p * dirs + d] = gather.ProbePosition(i, j, k), rays[p * dirs + d] = gather.directions[d];
+      }
+    }
+  }
+  std::vector<scene::RayHit> hits(origins.size());
+  caster.IntersectMany(origins.data(), rays.data(), origins.size(), 0.0f, hits.data());
+  std::vector<uint8_t> inside(probes, 0);
+  for (size_t p = 0; p < probes; ++p) {
+    size_t back = 0;
+    for (size_t d = 0; d < dirs; ++d) {
+      // A face through the probe itself (the ground under the volume's floor) says nothing.
+      const scene::RayHit& hit = hits[p * dirs + d];
+      back += hit.IsHit() && hit.back_face && hit.t > 1e-3f ? 1 : 0;
+    }
+    inside[p] = back * 4 > dirs ? 1 : 0;
+  }
+  return inside;
 }
 
 }  // namespace daylit::bake

@@ -15,6 +15,7 @@
 #include "bake/surface_light.h"
 #include "bake/texture_detail.h"
 #include "scene/scene.h"
+#include "sh/gather_tables.h"
 
 namespace daylit::bake {
 
@@ -60,16 +61,6 @@ struct CameraGBuffer {
   size_t DiffuseCount() const;
 };
 
-// Seed 001's "which pixels of the environment map are used in which key point".
-struct GatherTables {
-  glm::vec3 min{0.0f}, max{0.0f};
-  glm::ivec3 resolution{0};
-  std::vector<glm::vec3> directions;  // SphericalFibonacci(gather_directions)
-  std::vector<uint32_t> texel;        // [probe · directions + d]; probe = (k·ny + j)·nx + i
-
-  size_t ProbeCount() const { return static_cast<size_t>(resolution.x) * resolution.y * resolution.z; }
-  glm::vec3 ProbePosition(int i, int j, int k) const;
-};
 
 struct SurfaceAlbedo {
   std::string surface;
@@ -82,7 +73,7 @@ struct SceneBake {
   CaptureSun capture_sun;
   EnvMapMaps env;
   CameraGBuffer camera;
-  GatherTables gather;  // empty when the scene has no volume
+  sh::GatherTables gather;  // empty when the scene has no volume
   std::vector<SurfaceAlbedo> albedo_table;
 };
 
@@ -113,5 +104,10 @@ SceneBake BakeOrLoad(const scene::Scene& scene, const BakeOptions& options, cons
 
 // albedo.csv: `surface,r,g,b,pixels` (pixels: the env-map texels behind the median).
 std::string AlbedoCsv(const std::vector<SurfaceAlbedo>& table);
+
+// Probes inside the model: from inside, most gather rays leave through the back of a face; a
+// probe is inside when more than a quarter of its rays do. (A probe exactly on a surface, such
+// as the ground at the volume's floor, is not: it sees the surface as a black half.)
+std::vector<uint8_t> ProbesInsideModel(const sh::GatherTables& gather, const scene::RayCaster& caster);
 
 }  // namespace daylit::bake

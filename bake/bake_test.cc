@@ -6,7 +6,7 @@
 
 #include "bake/synthetic_recording.h"
 #include "base/error.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 #include "scene/raycaster.h"
 
 namespace daylit::bake {
@@ -61,15 +61,15 @@ TEST(BakeTest, SunVisibilityCastsTheWallsShadow) {
 }
 
 TEST(BakeTest, SunDiscIsMeasuredAndRemoved) {
-  scene::HdrImage env{1024, 512, std::vector<float>(1024 * 512 * 3, 2.0f)};
+  HdrImage env{1024, 512, std::vector<float>(1024 * 512 * 3, 2.0f)};
   const glm::dvec3 sun = glm::normalize(glm::dvec3(0.3, 0.5, 0.6));
   double dni = 0.0;
   for (int v = 0; v < env.height; ++v) {
     for (int u = 0; u < env.width; ++u) {
-      if (glm::dot(scene::LatLongDirection(u, v, env.width, env.height), sun) < std::cos(glm::radians(0.6))) continue;
+      if (glm::dot(LatLongDirection(u, v, env.width, env.height), sun) < std::cos(glm::radians(0.6))) continue;
       float* p = env.Pixel(u, v);
       p[0] = 5002.0f, p[1] = 4002.0f, p[2] = 3002.0f;
-      dni += 5000.0 * scene::LatLongTexelSolidAngle(v, env.width, env.height);
+      dni += 5000.0 * LatLongTexelSolidAngle(v, env.width, env.height);
     }
   }
   const CaptureSun found = ExtractSun(&env, sun, std::nullopt, "test");
@@ -88,11 +88,11 @@ TEST(BakeTest, SunDiscIsMeasuredAndRemoved) {
 TEST(BakeTest, SkyFillFollowsZenithAngleAndSunAngle) {
   // A sky that brightens toward the horizon (radiance 1 + 9·(1 − cos θ)), with the lower half of
   // the azimuths hidden (is_sky = 0): the fill must restore the same law there.
-  scene::HdrImage env{360, 180, std::vector<float>(360 * 180 * 3, 0.0f)};
+  HdrImage env{360, 180, std::vector<float>(360 * 180 * 3, 0.0f)};
   std::vector<uint8_t> is_sky(360 * 180, 0);
   for (int v = 0; v < 90; ++v) {
     for (int u = 0; u < 360; ++u) {
-      const glm::dvec3 d = scene::LatLongDirection(u, v, 360, 180);
+      const glm::dvec3 d = LatLongDirection(u, v, 360, 180);
       float* p = env.Pixel(u, v);
       const float l = static_cast<float>(1.0 + 9.0 * (1.0 - d.z));
       if (u < 180) {
@@ -101,9 +101,9 @@ TEST(BakeTest, SkyFillFollowsZenithAngleAndSunAngle) {
       }
     }
   }
-  const scene::HdrImage sky = SkyOnly(env, is_sky, glm::vec3(0, 0, 1));  // sun at the zenith: γ = θ
+  const HdrImage sky = SkyOnly(env, is_sky, glm::vec3(0, 0, 1));  // sun at the zenith: γ = θ
   for (int v = 0; v < 90; v += 7) {
-    const float expected = static_cast<float>(1.0 + 9.0 * (1.0 - scene::LatLongDirection(270, v, 360, 180).z));
+    const float expected = static_cast<float>(1.0 + 9.0 * (1.0 - LatLongDirection(270, v, 360, 180).z));
     EXPECT_NEAR(sky.Pixel(270, v)[0], expected, 0.2f) << v;  // within a 1° bin's spread
   }
 }
@@ -123,7 +123,7 @@ TEST(BakeTest, UniformSkyGivesBackTheGroundAlbedo) {
   // Gather tables: 8 probes × 256 directions; sky directions keep their texel, ground directions
   // take the texel that shows their hit point from the capture position (parallax).
   ASSERT_EQ(bake.gather.ProbeCount(), 8u);
-  const GatherTables& g = bake.gather;
+  const sh::GatherTables& g = bake.gather;
   const glm::vec3 capture(0.0f, 0.0f, 1.5f);
   for (size_t d = 0; d < g.directions.size(); ++d) {
     const glm::vec3 probe = g.ProbePosition(1, 1, 0);  // (1, 1, 0.5)
@@ -132,7 +132,7 @@ TEST(BakeTest, UniformSkyGivesBackTheGroundAlbedo) {
     glm::dvec3 toward = glm::dvec3(dir);
     if (dir.z < 0.0f) toward = glm::dvec3(probe + (-probe.z / dir.z) * dir - capture);
     EXPECT_EQ(g.texel[probe_index * g.directions.size() + d],
-              static_cast<uint32_t>(scene::LatLongTexel(toward, bake.env.width, bake.env.height)));
+              static_cast<uint32_t>(LatLongTexel(toward, bake.env.width, bake.env.height)));
   }
 }
 
@@ -143,7 +143,7 @@ TEST(BakeTest, DiffuseMaskOverTheEnvMapSelectsPixels) {
   cv::Mat mask(rec.env_width / 2, rec.env_width, CV_8UC1, cv::Scalar(0));
   for (int v = 0; v < mask.rows; ++v) {
     for (int u = 0; u < mask.cols; ++u) {
-      if (scene::LatLongDirection(u, v, mask.cols, mask.rows).x < 0.0) mask.at<uint8_t>(v, u) = 255;
+      if (LatLongDirection(u, v, mask.cols, mask.rows).x < 0.0) mask.at<uint8_t>(v, u) = 255;
     }
   }
   rec.Write();

@@ -8,7 +8,7 @@
 
 #include "base/log.h"
 #include "scene/hdr_image.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::bake {
 namespace {
@@ -36,16 +36,16 @@ void FillFromNearest(std::vector<glm::dvec3>* values, const std::vector<uint8_t>
 
 }  // namespace
 
-glm::vec3 TexelRadiance(const scene::HdrImage& env, int texel) {
+glm::vec3 TexelRadiance(const HdrImage& env, int texel) {
   const float* p = &env.rgb[static_cast<size_t>(texel) * 3];
   return {p[0], p[1], p[2]};
 }
 
-glm::vec3 Lookup(const scene::HdrImage& env, const glm::vec3& dir) {
-  return TexelRadiance(env, scene::LatLongTexel(glm::dvec3(dir), env.width, env.height));
+glm::vec3 Lookup(const HdrImage& env, const glm::vec3& dir) {
+  return TexelRadiance(env, LatLongTexel(glm::dvec3(dir), env.width, env.height));
 }
 
-CaptureSun ExtractSun(scene::HdrImage* env, const glm::dvec3& sun_dir, const std::optional<glm::dvec3>& given_dni,
+CaptureSun ExtractSun(HdrImage* env, const glm::dvec3& sun_dir, const std::optional<glm::dvec3>& given_dni,
                       const std::string& name) {
   CaptureSun sun;
   sun.dir = glm::vec3(glm::normalize(sun_dir));
@@ -58,7 +58,7 @@ CaptureSun ExtractSun(scene::HdrImage* env, const glm::dvec3& sun_dir, const std
   glm::dvec3 brightest_dir(0.0);
   for (int v = 0; v < env->height; ++v) {
     for (int u = 0; u < env->width; ++u) {
-      const glm::dvec3 d = scene::LatLongDirection(u, v, env->width, env->height);
+      const glm::dvec3 d = LatLongDirection(u, v, env->width, env->height);
       const float* p = env->Pixel(u, v);
       if (scene::Luminance(p) > brightest) brightest = scene::Luminance(p), brightest_dir = d;
       const double c = glm::dot(d, glm::dvec3(sun.dir));
@@ -85,7 +85,7 @@ CaptureSun ExtractSun(scene::HdrImage* env, const glm::dvec3& sun_dir, const std
   glm::dvec3 dni(0.0);
   for (const size_t texel : disc) {
     float* p = &env->rgb[texel * 3];
-    const double solid_angle = scene::LatLongTexelSolidAngle(static_cast<int>(texel / static_cast<size_t>(env->width)), env->width, env->height);
+    const double solid_angle = LatLongTexelSolidAngle(static_cast<int>(texel / static_cast<size_t>(env->width)), env->width, env->height);
     for (int k = 0; k < 3; ++k) {
       dni[k] += std::max(0.0, static_cast<double>(p[k]) - background[k]) * solid_angle;
       p[k] = background[k];
@@ -106,16 +106,16 @@ size_t SkyDistribution::BinOf(const glm::vec3& dir, const glm::vec3& sun_dir) {
   return static_cast<size_t>(ti) * kGammaBins + static_cast<size_t>(gi);
 }
 
-SkyDistribution::SkyDistribution(const scene::HdrImage& env, const std::vector<uint8_t>& is_sky,
+SkyDistribution::SkyDistribution(const HdrImage& env, const std::vector<uint8_t>& is_sky,
                                  const glm::vec3& sun_dir) {
   std::vector<glm::dvec3> sum(kThetaBins * kGammaBins, glm::dvec3(0.0));
   std::vector<double> weight(sum.size(), 0.0);
   for (int v = 0; v < env.height; ++v) {
-    const double solid_angle = scene::LatLongTexelSolidAngle(v, env.width, env.height);
+    const double solid_angle = LatLongTexelSolidAngle(v, env.width, env.height);
     for (int u = 0; u < env.width; ++u) {
       if (!is_sky[static_cast<size_t>(v) * env.width + u]) continue;
       const float* p = env.Pixel(u, v);
-      const size_t b = BinOf(glm::vec3(scene::LatLongDirection(u, v, env.width, env.height)), sun_dir);
+      const size_t b = BinOf(glm::vec3(LatLongDirection(u, v, env.width, env.height)), sun_dir);
       sum[b] += solid_angle * glm::dvec3(p[0], p[1], p[2]);
       weight[b] += solid_angle;
     }
@@ -202,14 +202,14 @@ glm::dvec3 SkyDistribution::HorizontalIrradiance(const glm::vec3& sun_dir) const
   return sum;
 }
 
-scene::HdrImage SkyOnly(const scene::HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir) {
+HdrImage SkyOnly(const HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir) {
   const SkyDistribution distribution(env, is_sky, sun_dir);
   if (distribution.empty()) return env;
-  scene::HdrImage sky = env;
+  HdrImage sky = env;
   for (int v = 0; v < env.height; ++v) {
     for (int u = 0; u < env.width; ++u) {
       if (is_sky[static_cast<size_t>(v) * env.width + u]) continue;
-      const glm::vec3 m = distribution.Radiance(glm::vec3(scene::LatLongDirection(u, v, env.width, env.height)), sun_dir);
+      const glm::vec3 m = distribution.Radiance(glm::vec3(LatLongDirection(u, v, env.width, env.height)), sun_dir);
       float* p = sky.Pixel(u, v);
       p[0] = m.x, p[1] = m.y, p[2] = m.z;
     }

@@ -32,7 +32,7 @@ struct CaptureSun {
 // the annulus around it) and measures its DNI: Σ (L − L_annulus) dΩ over the disc. Warns when the
 // map's brightest texel lies more than 2° from the ephemeris sun (a wrong north, time or map
 // orientation). `given_dni` (sun_irradiance_rgb) wins over the map's own disc.
-CaptureSun ExtractSun(scene::HdrImage* env, const glm::dvec3& sun_dir, const std::optional<glm::dvec3>& given_dni,
+CaptureSun ExtractSun(HdrImage* env, const glm::dvec3& sun_dir, const std::optional<glm::dvec3>& given_dni,
                       const std::string& name);
 
 // The captured sky as a function of the zenith angle θ and the angle γ from the sun (1° × 2°
@@ -46,7 +46,7 @@ class SkyDistribution {
  public:
   SkyDistribution() = default;
   // From `env` (sun disc removed) where `is_sky[texel]`, with the sun at unit `sun_dir`.
-  SkyDistribution(const scene::HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir);
+  SkyDistribution(const HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir);
 
   bool empty() const { return mean_.empty(); }
   // Radiance toward unit `dir` with the sun at unit `sun_dir` (bilinear between bins).
@@ -64,10 +64,10 @@ class SkyDistribution {
 
 // The sky as seen from anywhere: `env` where the capture point sees sky (`is_sky[texel]`); where
 // it sees the model instead, the SkyDistribution of the visible sky at the same (θ, γ).
-scene::HdrImage SkyOnly(const scene::HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir);
+HdrImage SkyOnly(const HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir);
 
 // Nearest-texel radiance of a lat-long map in direction `dir`, and of texel index `texel`.
-glm::vec3 Lookup(const scene::HdrImage& env, const glm::vec3& dir);
-glm::vec3 TexelRadiance(const scene::HdrImage& env, int texel);
+glm::vec3 Lookup(const HdrImage& env, const glm::vec3& dir);
+glm::vec3 TexelRadiance(const HdrImage& env, int texel);
 
 }  // namespace daylit::bake

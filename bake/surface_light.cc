@@ -10,7 +10,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include "bake/sampling.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::bake {
 namespace {
@@ -29,7 +29,7 @@ glm::vec3 DirectSun(const CaptureScene& capture, const glm::vec3& origin, const 
 // Radiance of model point y (hit by a ray, with `hit`'s surface and normal) at capture time.
 glm::vec3 RadianceAt(const CaptureScene& capture, const glm::vec3& y, const scene::RayHit& hit) {
   const glm::vec3 toward = y - capture.capture_position;
-  const int texel = scene::LatLongTexel(glm::dvec3(toward), capture.env->width, capture.env->height);
+  const int texel = LatLongTexel(glm::dvec3(toward), capture.env->width, capture.env->height);
   const glm::vec3 texel_radiance = TexelRadiance(*capture.env, texel);
   if (capture.hidden == nullptr || capture.env_distance == nullptr) return texel_radiance;
   if (CaptureSees(toward, hit.normal, hit.surface, (*capture.env_distance)[static_cast<size_t>(texel)],

@@ -35,8 +35,8 @@ struct HiddenSurfaceModel {
 // What the scene looked like at capture time.
 struct CaptureScene {
   const scene::RayCaster* caster = nullptr;
-  const scene::HdrImage* env = nullptr;  // captured radiance, sun disc removed
-  const scene::HdrImage* sky = nullptr;  // SkyOnly(env): sky radiance in every direction
+  const HdrImage* env = nullptr;  // captured radiance, sun disc removed
+  const HdrImage* sky = nullptr;  // SkyOnly(env): sky radiance in every direction
   const std::vector<float>* env_distance = nullptr;    // per texel: capture point to its hit (< 0: sky)
   const std::vector<uint32_t>* env_surface = nullptr;  // per texel: the surface it shows
   const HiddenSurfaceModel* hidden = nullptr;         // null: hidden points take the texel's radiance

@@ -14,7 +14,7 @@
 
 #include "base/atomic_file.h"
 #include "scene/hdr_image.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::bake::testing {
 
@@ -54,7 +54,7 @@ struct SyntheticRecording {
     std::vector<float> r(static_cast<size_t>(env_width) * h), g(r.size()), b(r.size());
     for (int v = 0; v < h; ++v) {
       for (int u = 0; u < env_width; ++u) {
-        const glm::vec3 l = env(scene::LatLongDirection(u, v, env_width, h));
+        const glm::vec3 l = env(LatLongDirection(u, v, env_width, h));
         const size_t i = static_cast<size_t>(v) * env_width + u;
         r[i] = l.x, g[i] = l.y, b[i] = l.z;
       }

@@ -44,7 +44,7 @@ std::vector<cv::Mat> ReadFrames(const scene::Scene& scene, const std::vector<int
   for (const int i : indices) {
     const std::filesystem::path path = scene.frames.ImagePath(i);
     if (path.extension() == ".exr") {
-      scene::HdrImage image = scene::ReadHdrImage(path);
+      HdrImage image = scene::ReadHdrImage(path);
       cv::Mat rgb(image.height, image.width, CV_32FC3, image.rgb.data());
       cv::Mat bgr;
       cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
@@ -54,6 +54,67 @@ std::vector<cv::Mat> ReadFrames(const scene::Scene& scene, const std::vector<int
     }
   }
   return frames;
+}
+
+// Which box each pixel uses (an index into kBoxSizes; −1: no point): an env texel (π/H rad
+// seen from the capture point) in camera pixels. `used` marks the sizes some pixel uses.
+std::vector<int8_t> BoxPerPixel(const scene::Scene& scene, const std::vector<glm::vec3>& points,
+                                const std::vector<uint8_t>& has_point, int env_height, float footprint_scale,
+                                std::array<bool, kBoxSizes.size()>* used) {
+  const glm::vec3 capture(scene.envmap->position);
+  const glm::vec3 center(scene.Camera().CenterInWorld());
+  const float texel_rad = glm::pi<float>() / static_cast<float>(env_height);
+  const float focal = static_cast<float>(0.5 * (scene.intrinsics.fx + scene.intrinsics.fy));
+  std::vector<int8_t> box(points.size(), -1);
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!has_point[i]) continue;
+    const float pixels = footprint_scale * glm::length(points[i] - capture) * texel_rad * focal /
+                         glm::length(points[i] - center);
+    size_t b = 0;
+    while (b + 1 < kBoxSizes.size() && static_cast<float>(kBoxSizes[b + 1]) <= pixels + 1.0f) ++b;
+    box[i] = static_cast<int8_t>(b);
+    (*used)[b] = true;
+  }
+  return box;
+}
+
+// One linear frame's I / blur(I) per pixel and channel, with the pixel's own box, added to
+// `samples` (channels in BGR order, as OpenCV's). NaN-aware box means: the values blurred with
+// NaN as 0, divided by the blurred validity.
+void AddFrameDetail(const cv::Mat& linear, const std::vector<int8_t>& box, const std::array<bool, kBoxSizes.size()>& used,
+                    std::vector<std::array<std::vector<float>, 3>>* samples) {
+  const int w = linear.cols, h = linear.rows;
+  cv::Mat valid(linear.size(), CV_32FC3), values = linear.clone();
+  for (int y = 0; y < h; ++y) {
+    cv::Vec3f* v = values.ptr<cv::Vec3f>(y);
+    cv::Vec3f* m = valid.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < w; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        m[x][c] = std::isnan(v[x][c]) ? 0.0f : 1.0f;
+        if (std::isnan(v[x][c])) v[x][c] = 0.0f;
+      }
+    }
+  }
+  for (size_t b = 0; b < kBoxSizes.size(); ++b) {
+    if (!used[b]) continue;
+    cv::Mat sum, weight;
+    const cv::Size size(kBoxSizes[b], kBoxSizes[b]);
+    cv::blur(values, sum, size, cv::Point(-1, -1), cv::BORDER_REFLECT);
+    cv::blur(valid, weight, size, cv::Point(-1, -1), cv::BORDER_REFLECT);
+    for (int y = 0; y < h; ++y) {
+      const cv::Vec3f* l = linear.ptr<cv::Vec3f>(y);
+      const cv::Vec3f* s = sum.ptr<cv::Vec3f>(y);
+      const cv::Vec3f* wt = weight.ptr<cv::Vec3f>(y);
+      for (int x = 0; x < w; ++x) {
+        const size_t i = static_cast<size_t>(y) * w + x;
+        if (box[i] != static_cast<int8_t>(b)) continue;
+        for (int c = 0; c < 3; ++c) {
+          const float mean = wt[x][c] > 0.5f ? s[x][c] / wt[x][c] : 0.0f;
+          if (!std::isnan(l[x][c]) && mean > 1e-4f) (*samples)[i][static_cast<size_t>(2 - c)].push_back(l[x][c] / mean);
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -71,62 +132,14 @@ std::vector<glm::vec3> CameraTextureDetail(const scene::Scene& scene, const std:
     if (indices.empty() || i > indices.back()) indices.push_back(std::min(i, count - 1));
   }
   const std::vector<cv::Mat> frames = ReadFrames(scene, indices);
-
-  // Which box each pixel uses: an env texel (π/H rad seen from the capture point) in camera pixels.
-  const glm::vec3 capture(scene.envmap->position);
-  const glm::vec3 center(scene.Camera().CenterInWorld());
-  const float texel_rad = glm::pi<float>() / static_cast<float>(env_height);
-  const float focal = static_cast<float>(0.5 * (scene.intrinsics.fx + scene.intrinsics.fy));
-  std::vector<int8_t> box(detail.size(), -1);
   std::array<bool, kBoxSizes.size()> used{};
-  for (size_t i = 0; i < detail.size(); ++i) {
-    if (!has_point[i]) continue;
-    const float pixels = options.footprint_scale * glm::length(points[i] - capture) * texel_rad * focal /
-                         glm::length(points[i] - center);
-    size_t b = 0;
-    while (b + 1 < kBoxSizes.size() && static_cast<float>(kBoxSizes[b + 1]) <= pixels + 1.0f) ++b;
-    box[i] = static_cast<int8_t>(b);
-    used[b] = true;
-  }
-
+  const std::vector<int8_t> box = BoxPerPixel(scene, points, has_point, env_height, options.footprint_scale, &used);
   std::vector<std::array<std::vector<float>, 3>> samples(detail.size());
   size_t decoded = 0;
   for (const cv::Mat& frame : frames) {
     if (frame.empty() || frame.cols != w || frame.rows != h) continue;
     ++decoded;
-    const cv::Mat linear = Linearize(frame, scene.response);
-    // NaN-aware box means: blur the values with NaN as 0 and divide by the blurred validity.
-    cv::Mat valid(linear.size(), CV_32FC3), values = linear.clone();
-    for (int y = 0; y < h; ++y) {
-      cv::Vec3f* v = values.ptr<cv::Vec3f>(y);
-      cv::Vec3f* m = valid.ptr<cv::Vec3f>(y);
-      for (int x = 0; x < w; ++x) {
-        for (int c = 0; c < 3; ++c) {
-          m[x][c] = std::isnan(v[x][c]) ? 0.0f : 1.0f;
-          if (std::isnan(v[x][c])) v[x][c] = 0.0f;
-        }
-      }
-    }
-    for (size_t b = 0; b < kBoxSizes.size(); ++b) {
-      if (!used[b]) continue;
-      cv::Mat sum, weight;
-      const cv::Size size(kBoxSizes[b], kBoxSizes[b]);
-      cv::blur(values, sum, size, cv::Point(-1, -1), cv::BORDER_REFLECT);
-      cv::blur(valid, weight, size, cv::Point(-1, -1), cv::BORDER_REFLECT);
-      for (int y = 0; y < h; ++y) {
-        const cv::Vec3f* l = linear.ptr<cv::Vec3f>(y);
-        const cv::Vec3f* s = sum.ptr<cv::Vec3f>(y);
-        const cv::Vec3f* wt = weight.ptr<cv::Vec3f>(y);
-        for (int x = 0; x < w; ++x) {
-          const size_t i = static_cast<size_t>(y) * w + x;
-          if (box[i] != static_cast<int8_t>(b)) continue;
-          for (int c = 0; c < 3; ++c) {
-            const float mean = wt[x][c] > 0.5f ? s[x][c] / wt[x][c] : 0.0f;
-            if (!std::isnan(l[x][c]) && mean > 1e-4f) samples[i][static_cast<size_t>(2 - c)].push_back(l[x][c] / mean);
-          }
-        }
-      }
-    }
+    AddFrameDetail(Linearize(frame, scene.response), box, used, &samples);
   }
   if (decoded == 0) {
     Log().warn("{}: no frame could be read: camera albedo keeps the env map's resolution", scene.file.string());

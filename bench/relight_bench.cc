@@ -14,13 +14,13 @@
 #include "lightfit/light_fit.h"
 #include "lightfit/lights.h"
 #include "scene/scene.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::relight {
 namespace {
 
 void BM_VolumeUpdate512Probes(benchmark::State& state) {
-  bake::GatherTables gather;
+  sh::GatherTables gather;
   gather.min = glm::vec3(-2.0f), gather.max = glm::vec3(2.0f);
   gather.resolution = glm::ivec3(8);
   gather.directions = bake::SphericalFibonacci(static_cast<int>(state.range(0)));
@@ -37,7 +37,7 @@ void BM_VolumeUpdate512Probes(benchmark::State& state) {
         for (size_t d = 0; d < dirs; ++d) {
           const glm::vec3 v = gather.directions[d];
           const float b = glm::dot(o, v), t = -b + std::sqrt(b * b - glm::dot(o, o) + 25.0f);
-          gather.texel[p * dirs + d] = static_cast<uint32_t>(scene::LatLongTexel(glm::dvec3(o + t * v), 1024, 512));
+          gather.texel[p * dirs + d] = static_cast<uint32_t>(LatLongTexel(glm::dvec3(o + t * v), 1024, 512));
         }
       }
     }
@@ -57,14 +57,14 @@ BENCHMARK(BM_VolumeUpdate512Probes)->Arg(256)->Arg(512)->Unit(benchmark::kMillis
 // Seed 002's ground truth: 20 480 icosahedron normals (bar ≤ 5 s) and a whole 1024×512
 // irradiance map (bar ≤ 60 s; HDRShop took 24 hours) from a 1024×512 probe, on 2 cores.
 void BM_ExactIrradiance20480(benchmark::State& state) {
-  const scene::HdrImage probe = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
+  const HdrImage probe = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
   const std::vector<glm::vec3> normals = sh::IcosahedronNormals(5);
   for (auto _ : state) benchmark::DoNotOptimize(sh::ExactIrradiance(probe, normals).data());
 }
 BENCHMARK(BM_ExactIrradiance20480)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_ExactIrradianceMap1024x512(benchmark::State& state) {
-  const scene::HdrImage probe = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
+  const HdrImage probe = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
   for (auto _ : state) benchmark::DoNotOptimize(sh::ExactIrradianceMap(probe, 1024, 512).data());
 }
 BENCHMARK(BM_ExactIrradianceMap1024x512)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
@@ -73,7 +73,7 @@ BENCHMARK(BM_ExactIrradianceMap1024x512)->Unit(benchmark::kSecond)->UseRealTime(
 // the fitting normals, median cut's start and the Ceres fit (bar for 8 lights ≤ 200 ms on 2
 // cores). Rooitou Park (outdoor, with the sun) takes the most iterations of the bundled probes.
 void BM_IrradianceOptimization(benchmark::State& state, const char* file) {
-  const scene::HdrImage probe = scene::ReadHdrImage(std::string(DAYLIT_SOURCE_DIR "/probes/") + file);
+  const HdrImage probe = scene::ReadHdrImage(std::string(DAYLIT_SOURCE_DIR "/probes/") + file);
   int iterations = 0;
   for (auto _ : state) {
     const lightfit::LightFitResult fit = lightfit::IrradianceOptimization(probe, static_cast<int>(state.range(0)));
@@ -88,7 +88,7 @@ BENCHMARK_CAPTURE(BM_IrradianceOptimization, rooitou, "rooitou_park_1k.hdr")
     ->Arg(4)->Arg(8)->Arg(32)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_MedianCut(benchmark::State& state) {
-  const scene::HdrImage probe = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
+  const HdrImage probe = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
   for (auto _ : state) benchmark::DoNotOptimize(lightfit::MedianCutLights(probe, static_cast<int>(state.range(0))).lights.data());
 }
 BENCHMARK(BM_MedianCut)->Arg(8)->Arg(128)->Unit(benchmark::kMillisecond);

@@ -13,7 +13,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include "bake/sampling.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::composite {
 namespace {
@@ -79,7 +79,7 @@ ObjectShadows::ObjectShadows(const scene::Scene& scene, const bake::SceneBake& b
         // What the object hides: the real point behind it, seen from the capture position, or sky.
         const scene::RayHit behind = real_.Intersect(origin, dir, object.t);
         const glm::dvec3 toward = behind.IsHit() ? glm::dvec3(origin + behind.t * dir - capture) : glm::dvec3(dir);
-        texels[i].push_back(static_cast<uint32_t>(scene::LatLongTexel(toward, env_w, env_h)));
+        texels[i].push_back(static_cast<uint32_t>(LatLongTexel(toward, env_w, env_h)));
         sky += behind.IsHit() ? 0 : 1;
       }
       a.sky_lost = static_cast<float>(sky) / static_cast<float>(hemisphere.size());

@@ -13,15 +13,15 @@
 
 #include "bake/sampling.h"
 #include "bake/surface_light.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::estimation {
 namespace {
 
 constexpr size_t kGrain = 32;  // pixels per task
 
-scene::HdrImage ImageOf(const bake::EnvMapMaps& env) {
-  scene::HdrImage image{env.width, env.height, std::vector<float>(env.radiance.size() * 3)};
+HdrImage ImageOf(const bake::EnvMapMaps& env) {
+  HdrImage image{env.width, env.height, std::vector<float>(env.radiance.size() * 3)};
   for (size_t t = 0; t < env.radiance.size(); ++t) {
     for (int c = 0; c < 3; ++c) image.rgb[t * 3 + static_cast<size_t>(c)] = env.radiance[t][c];
   }
@@ -65,36 +65,39 @@ void LightTransfer::Trace(const std::vector<uint32_t>& pixels) {
     fresh.push_back(p);
   }
   if (fresh.empty()) return;
-  struct Local {
-    std::vector<glm::vec3> low_sky;  // rays that escape below the horizon
-    std::vector<glm::vec3> blocked;  // rays above the horizon that the model stops
-    std::vector<Bounce> bounces;
-  };
-  std::vector<Local> local(fresh.size());
+  std::vector<TracedPixel> traced(fresh.size());
+  TraceHemispheres(fresh, &traced);
+  FillHiddenSkyVisibility(&traced);
+  StorePaths(fresh, traced);
+}
+
+// Albedo and V of a bounce point: the env maps' where the capture point sees it; else the
+// surface's median albedo, and V marked (−1) for FillHiddenSkyVisibility.
+LightTransfer::Bounce LightTransfer::BounceAt(const glm::vec3& y, const scene::RayHit& hit) const {
   const bake::EnvMapMaps& env = bake_.env;
-  // Albedo and V of a bounce point: the env maps' where the capture point sees it; else the
-  // surface's median albedo, and V marked (−1) for the cells pass below.
-  const auto bounce_at = [&](const glm::vec3& y, const scene::RayHit& hit) {
-    Bounce b{y + options_.offset_m * hit.normal, hit.normal, glm::vec3(0.0f), -1.0f, hit.surface, 0};
-    if (env.width > 0) {
-      const glm::vec3 toward = y - capture_position_;
-      const size_t texel = static_cast<size_t>(scene::LatLongTexel(glm::dvec3(toward), env.width, env.height));
-      const float seen = env.IsSky(texel) ? -1.0f : glm::length(env.point[texel] - capture_position_);
-      if (bake::CaptureSees(toward, hit.normal, hit.surface, seen, env.surface[texel], env.height) &&
-          glm::compMax(env.albedo[texel]) > 0.0f) {
-        b.albedo = env.albedo[texel];
-        b.sky_visibility = env.sky_visibility[texel];
-        return b;
-      }
+  Bounce b{y + options_.offset_m * hit.normal, hit.normal, glm::vec3(0.0f), -1.0f, hit.surface, 0};
+  if (env.width > 0) {
+    const glm::vec3 toward = y - capture_position_;
+    const size_t texel = static_cast<size_t>(LatLongTexel(glm::dvec3(toward), env.width, env.height));
+    const float seen = env.IsSky(texel) ? -1.0f : glm::length(env.point[texel] - capture_position_);
+    if (bake::CaptureSees(toward, hit.normal, hit.surface, seen, env.surface[texel], env.height) &&
+        glm::compMax(env.albedo[texel]) > 0.0f) {
+      b.albedo = env.albedo[texel];
+      b.sky_visibility = env.sky_visibility[texel];
+      return b;
     }
-    b.albedo = hit.surface < bake_.albedo_table.size() ? bake_.albedo_table[hit.surface].albedo : glm::vec3(0.0f);
-    return b;
-  };
+  }
+  b.albedo = hit.surface < bake_.albedo_table.size() ? bake_.albedo_table[hit.surface].albedo : glm::vec3(0.0f);
+  return b;
+}
+
+void LightTransfer::TraceHemispheres(const std::vector<uint32_t>& fresh, std::vector<TracedPixel>* traced) const {
   tbb::parallel_for(tbb::blocked_range<size_t>(0, fresh.size(), kGrain), [&](const tbb::blocked_range<size_t>& range) {
     thread_local std::vector<glm::vec3> dirs;
     thread_local std::vector<scene::RayHit> hits;
     for (size_t k = range.begin(); k != range.end(); ++k) {
       const uint32_t p = fresh[k];
+      TracedPixel& pixel = (*traced)[k];
       const glm::vec3 origin = points_.point[p] + options_.offset_m * points_.normal[p];
       const glm::mat3 frame = bake::HemisphereFrame(points_.normal[p], p);
       dirs.resize(hemisphere_.size()), hits.resize(hemisphere_.size());
@@ -105,25 +108,28 @@ void LightTransfer::Trace(const std::vector<uint32_t>& pixels) {
         low_sky += !hits[r].IsHit() && dirs[r].z <= 0.0f, blocked += hits[r].IsHit() && dirs[r].z > 0.0f;
         bounces += hits[r].IsHit() && options_.interreflection;
       }
-      local[k].low_sky.reserve(low_sky), local[k].blocked.reserve(blocked), local[k].bounces.reserve(bounces);
+      pixel.low_sky.reserve(low_sky), pixel.blocked.reserve(blocked), pixel.bounces.reserve(bounces);
       for (size_t r = 0; r < dirs.size(); ++r) {
         const glm::vec3& dir = dirs[r];
         const scene::RayHit& hit = hits[r];
         if (!hit.IsHit()) {
-          if (dir.z <= 0.0f) local[k].low_sky.push_back(dir);
+          if (dir.z <= 0.0f) pixel.low_sky.push_back(dir);
           continue;
         }
-        if (dir.z > 0.0f) local[k].blocked.push_back(dir);
-        if (options_.interreflection) local[k].bounces.push_back(bounce_at(origin + hit.t * dir, hit));
+        if (dir.z > 0.0f) pixel.blocked.push_back(dir);
+        if (options_.interreflection) pixel.bounces.push_back(BounceAt(origin + hit.t * dir, hit));
       }
     }
   });
-  // V of the bounce points the capture point does not see (~5% of them on courtyard-a), by ray
-  // casting, once per 25 cm cell of a surface side: V is smooth, and tracing each point alone
-  // cost more rays than the primary ones.
+}
+
+// V of the bounce points the capture point does not see (~5% of them on courtyard-a), by ray
+// casting, once per 25 cm cell of a surface side: V is smooth, and tracing each point alone
+// cost more rays than the primary ones.
+void LightTransfer::FillHiddenSkyVisibility(std::vector<TracedPixel>* traced) {
   std::vector<Bounce*> hidden;
-  for (Local& l : local) {
-    for (Bounce& b : l.bounces) {
+  for (TracedPixel& pixel : *traced) {
+    for (Bounce& b : pixel.bounces) {
       if (b.sky_visibility < 0.0f) hidden.push_back(&b);
     }
   }
@@ -150,17 +156,21 @@ void LightTransfer::Trace(const std::vector<uint32_t>& pixels) {
   });
   for (size_t i = 0; i < missing.size(); ++i) hidden_cells_[missing[i].first] = cell_v[i];
   for (size_t i = 0; i < hidden.size(); ++i) hidden[i]->sky_visibility = hidden_cells_[keys[i]];
+}
+
+void LightTransfer::StorePaths(const std::vector<uint32_t>& fresh, const std::vector<TracedPixel>& traced) {
   for (size_t k = 0; k < fresh.size(); ++k) {
+    const TracedPixel& pixel = traced[k];
     Paths paths;
     paths.orientation = OrientationOf(points_.normal[fresh[k]]);
     paths.low_sky_begin = static_cast<uint32_t>(low_sky_.size());
-    low_sky_.insert(low_sky_.end(), local[k].low_sky.begin(), local[k].low_sky.end());
+    low_sky_.insert(low_sky_.end(), pixel.low_sky.begin(), pixel.low_sky.end());
     paths.low_sky_end = static_cast<uint32_t>(low_sky_.size());
     paths.blocked_begin = static_cast<uint32_t>(blocked_.size());
-    blocked_.insert(blocked_.end(), local[k].blocked.begin(), local[k].blocked.end());
+    blocked_.insert(blocked_.end(), pixel.blocked.begin(), pixel.blocked.end());
     paths.blocked_end = static_cast<uint32_t>(blocked_.size());
     paths.bounce_begin = static_cast<uint32_t>(bounces_.size());
-    for (Bounce b : local[k].bounces) {
+    for (Bounce b : pixel.bounces) {
       b.orientation = OrientationOf(b.normal);
       bounces_.push_back(b);
     }
@@ -231,23 +241,37 @@ std::vector<glm::vec3> LightTransfer::ClearSkyPerUnitDhi(const glm::vec3& sun_di
 void LightTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct,
                             Transfer* out, Transfer* reflected_out) {
   Trace(pixels);
-  const bool day = sun_dir.z > 0.0f;
-  glm::vec3 inv_dhi(0.0f);  // of the clear sky under this sun
-  bool clear_sky = day && !sky_.empty();
-  if (clear_sky) {
-    const glm::dvec3 dhi = sky_.HorizontalIrradiance(sun_dir);
-    clear_sky = glm::compMin(dhi) > 0.0;
-    if (clear_sky) inv_dhi = glm::vec3(1.0 / dhi);
+  const ClearSky sky = ClearSkyUnder(sun_dir);
+  // The first bounce is kept apart from the direct terms for the per-surface means of the second.
+  std::vector<Transfer> reflected(pixels.size());
+  DirectAndFirstBounce(pixels, sun_dir, direct, sky, out, &reflected);
+  if (!options_.interreflection) {
+    if (reflected_out != nullptr) std::fill(reflected_out, reflected_out + pixels.size(), Transfer{});
+    return;
   }
-  const std::vector<OpenSky> open = clear_sky ? OpenSkyIntegrals(sun_dir, inv_dhi) : std::vector<OpenSky>{};
+  AddFurtherBounces(pixels, reflected, out, reflected_out);
+}
+
+LightTransfer::ClearSky LightTransfer::ClearSkyUnder(const glm::vec3& sun_dir) const {
+  ClearSky sky;
+  if (sun_dir.z <= 0.0f || sky_.empty()) return sky;
+  const glm::dvec3 dhi = sky_.HorizontalIrradiance(sun_dir);
+  if (!(glm::compMin(dhi) > 0.0)) return sky;
+  sky.on = true;
+  sky.inv_dhi = glm::vec3(1.0 / dhi);
+  sky.open = OpenSkyIntegrals(sun_dir, sky.inv_dhi);
+  return sky;
+}
+
+void LightTransfer::DirectAndFirstBounce(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir,
+                                         const float* direct, const ClearSky& sky, Transfer* out,
+                                         std::vector<Transfer>* reflected) const {
+  const bool day = sun_dir.z > 0.0f;
   // How much more of the clear sky than of a uniform one an open surface of each orientation gets.
   const auto clear_weight = [&](uint32_t o) {
-    return open[o].uniform > 1e-3f ? open[o].clear / open[o].uniform : glm::vec3(1.0f);
+    return sky.open[o].uniform > 1e-3f ? sky.open[o].clear / sky.open[o].uniform : glm::vec3(1.0f);
   };
   const float inv_rays = 1.0f / static_cast<float>(hemisphere_.size());
-  // First bounce: direct light at each bounce point. `reflected` keeps it apart from the direct
-  // terms for the per-surface means of the second.
-  std::vector<Transfer> reflected(pixels.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels.size(), kGrain), [&](const tbb::blocked_range<size_t>& range) {
     // The bounce points' shadow rays all run along the sun: traced per pixel as packets.
     thread_local std::vector<glm::vec3> origins;
@@ -270,7 +294,7 @@ void LightTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec3
       for (uint32_t i = paths.bounce_begin; i < paths.bounce_end; ++i) {
         const Bounce& b = bounces_[i];
         r.overcast += b.albedo * b.sky_visibility;
-        r.clear += b.albedo * b.sky_visibility * (clear_sky ? clear_weight(b.orientation) : glm::vec3(1.0f));
+        r.clear += b.albedo * b.sky_visibility * (sky.on ? clear_weight(b.orientation) : glm::vec3(1.0f));
       }
       r.sun *= inv_rays, r.clear *= inv_rays, r.overcast *= inv_rays;
       // The direct sky: V from the bake's many rays for the uniform sky. For the clear one, what
@@ -281,24 +305,25 @@ void LightTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec3
       t.sun = glm::vec3(day ? direct[p] : 0.0f);
       t.overcast = glm::vec3(v);
       t.clear = glm::vec3(v);
-      if (clear_sky) {
+      if (sky.on) {
         glm::vec3 blocked(0.0f), low(0.0f);
         for (uint32_t d = paths.blocked_begin; d < paths.blocked_end; ++d) blocked += sky_.Radiance(blocked_[d], sun_dir);
         for (uint32_t d = paths.low_sky_begin; d < paths.low_sky_end; ++d) low += sky_.Radiance(low_sky_[d], sun_dir);
-        t.clear = glm::max(open[paths.orientation].clear + (low - blocked) * glm::pi<float>() * inv_dhi * inv_rays,
+        t.clear = glm::max(sky.open[paths.orientation].clear + (low - blocked) * glm::pi<float>() * sky.inv_dhi * inv_rays,
                            glm::vec3(0.0f));
       }
       out[k] = t;
-      reflected[k] = r;
+      (*reflected)[k] = r;
     }
   });
-  if (!options_.interreflection) {
-    if (reflected_out != nullptr) std::fill(reflected_out, reflected_out + pixels.size(), Transfer{});
-    return;
-  }
-  // Further bounces: each bounce point's own reflected light, as its surface's mean over these
-  // pixels (surfaces without pixels here take the mean of all), iterated: the first pass gives the
-  // second bounce, the next the third.
+}
+
+// Further bounces: each bounce point's own reflected light, as its surface's mean over these
+// pixels (surfaces without pixels here take the mean of all), iterated: the first pass gives the
+// second bounce, the next the third.
+void LightTransfer::AddFurtherBounces(const std::vector<uint32_t>& pixels, const std::vector<Transfer>& reflected,
+                                      Transfer* out, Transfer* reflected_out) const {
+  const float inv_rays = 1.0f / static_cast<float>(hemisphere_.size());
   const size_t surfaces = bake_.albedo_table.size();
   std::vector<Transfer> indirect = reflected;  // all reflected light found so far, per pixel
   for (int bounce = 2; bounce <= options_.bounces; ++bounce) {

@@ -109,7 +109,31 @@ class LightTransfer {
     glm::vec3 clear{0.0f};  // ∫ (L_clear/DHI) max(0, n·ω) dω over the upper hemisphere
     float uniform = 0.0f;   // ∫ (1/π) max(0, n·ω) dω over the upper hemisphere
   };
+  // One pixel's rays as traced, before they are stored in the flat arrays below.
+  struct TracedPixel {
+    std::vector<glm::vec3> low_sky;  // rays that escape below the horizon
+    std::vector<glm::vec3> blocked;  // rays above the horizon that the model stops
+    std::vector<Bounce> bounces;
+  };
+  // The clear sky under one sun, normalised to a unit DHI; off (uniform only) at night or
+  // without a captured sky.
+  struct ClearSky {
+    bool on = false;
+    glm::vec3 inv_dhi{0.0f};
+    std::vector<OpenSky> open;  // per orientation
+  };
+  // Traces the paths of the pixels not traced yet (Trace's steps follow).
   void Trace(const std::vector<uint32_t>& pixels);
+  void TraceHemispheres(const std::vector<uint32_t>& fresh, std::vector<TracedPixel>* traced) const;
+  Bounce BounceAt(const glm::vec3& y, const scene::RayHit& hit) const;
+  void FillHiddenSkyVisibility(std::vector<TracedPixel>* traced);
+  void StorePaths(const std::vector<uint32_t>& fresh, const std::vector<TracedPixel>& traced);
+  // Compute's steps: the direct terms and the first bounce per pixel, then the further bounces.
+  ClearSky ClearSkyUnder(const glm::vec3& sun_dir) const;
+  void DirectAndFirstBounce(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct,
+                            const ClearSky& sky, Transfer* out, std::vector<Transfer>* reflected) const;
+  void AddFurtherBounces(const std::vector<uint32_t>& pixels, const std::vector<Transfer>& reflected, Transfer* out,
+                         Transfer* reflected_out) const;
   uint32_t OrientationOf(const glm::vec3& normal);  // index into orientations_, added if new
   static constexpr float kCellSize = 0.25f;         // m, for V of hidden bounce points
   static uint64_t CellOf(const Bounce& b);          // surface, cell and side (hashed)

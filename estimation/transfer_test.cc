@@ -123,11 +123,11 @@ TEST(TransferTest, SkyDistributionIntegratesToItsHorizontalIrradiance) {
   // L = 1 + 2·cos γ⁺ (brighter toward the sun): DHI = π + 2 ∫ max(0, cos γ) cos θ dω, which for
   // the sun at the zenith is π + 4π/3.
   const int w = 512, h = 256;
-  scene::HdrImage env{w, h, std::vector<float>(static_cast<size_t>(w) * h * 3)};
+  HdrImage env{w, h, std::vector<float>(static_cast<size_t>(w) * h * 3)};
   const glm::vec3 zenith(0.0f, 0.0f, 1.0f);
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
-      const glm::dvec3 d = scene::LatLongDirection(u, v, w, h);
+      const glm::dvec3 d = LatLongDirection(u, v, w, h);
       for (int c = 0; c < 3; ++c) env.Pixel(u, v)[c] = static_cast<float>(1.0 + 2.0 * std::max(0.0, d.z));
     }
   }

@@ -23,7 +23,7 @@ std::optional<TruthFrame> ReadTruthFrame(const scene::Scene& scene, int index) {
   if (!fs::is_regular_file(truth.with_file) || !fs::is_regular_file(without_file) || !fs::is_regular_file(mask_file)) {
     return std::nullopt;
   }
-  scene::HdrImage with = scene::ReadHdrImage(truth.with_file), without = scene::ReadHdrImage(without_file);
+  HdrImage with = scene::ReadHdrImage(truth.with_file), without = scene::ReadHdrImage(without_file);
   truth.mask = cv::imread(mask_file.string(), cv::IMREAD_GRAYSCALE);
   const int w = scene.intrinsics.width, h = scene.intrinsics.height;
   if (with.width != w || with.height != h || without.width != w || without.height != h || truth.mask.cols != w ||

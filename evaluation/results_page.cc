@@ -97,12 +97,17 @@ void AddRunFigures(const nlohmann::json& json, const std::string& prefix, const 
                    MeasuredFigures* figures) {
   if (!json.is_object()) ThrowInputError("{}: figures are a JSON object of numbers and texts", source);
   for (const auto& [key, value] : json.items()) {
+    const std::string name = prefix + "/" + key;
     if (value.is_number()) {
-      figures->numbers[prefix + "/" + key] = value.get<double>();
+      figures->numbers[name] = value.get<double>();
     } else if (value.is_string()) {
-      figures->texts[prefix + "/" + key] = value.get<std::string>();
-    } else {
-      ThrowInputError("{}: \"{}\" is neither a number nor a text", source, key);
+      figures->texts[name] = value.get<std::string>();
+    } else if (value.is_null()) {
+      figures->texts[name] = "none";
+    } else if (value.is_object()) {
+      AddRunFigures(value, name, source, figures);
+    } else if (!value.is_array()) {
+      ThrowInputError("{}: \"{}\" is neither a number, a text, an object nor an array", source, name);
     }
   }
 }
@@ -110,11 +115,15 @@ void AddRunFigures(const nlohmann::json& json, const std::string& prefix, const 
 MeasuredFigures LoadMeasuredFigures(const std::filesystem::path& folder) {
   if (!std::filesystem::is_directory(folder)) ThrowInputError("{}: not a folder of measured figures", folder.string());
   std::vector<std::filesystem::path> files;
+  MeasuredFigures figures;
   for (const auto& entry : std::filesystem::recursive_directory_iterator(folder)) {
-    if (entry.is_regular_file() && entry.path().extension() == ".json") files.push_back(entry.path());
+    if (!entry.is_regular_file()) continue;
+    if (entry.path().extension() == ".json") files.push_back(entry.path());
+    if (entry.path().extension() == ".csv") {
+      figures.tables[entry.path().lexically_relative(folder).generic_string()] = ReadCsvFile(entry.path());
+    }
   }
   std::sort(files.begin(), files.end());
-  MeasuredFigures figures;
   for (const std::filesystem::path& file : files) {
     std::ifstream in(file);
     nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
@@ -139,6 +148,7 @@ std::string FormatFigure(double value, const std::string& unit) {
   if (scale == kScale.end() && unit != "/s") ThrowInputError("unit \"{}\" is not one of s, ms, us, /s, %, k, M", unit);
   const double v = unit == "/s" ? 1.0 / value : value * scale->second;
   if (v == 0.0 || !std::isfinite(v)) return fmt::format("{}", v);
+  if (unit.empty() && std::floor(v) == v && std::abs(v) < 1e15) return fmt::format("{:.0f}", v);  // a count
   const int magnitude = static_cast<int>(std::floor(std::log10(std::abs(v))));
   if (magnitude >= 2) {
     const double step = std::pow(10.0, magnitude - 2);
@@ -146,6 +156,49 @@ std::string FormatFigure(double value, const std::string& unit) {
   }
   return fmt::format("{:.{}f}", v, 2 - magnitude);
 }
+
+namespace {
+
+// `{{csv:path|column:unit:title,...}}`'s table, as Markdown.
+std::string MarkdownTable(const CsvTable& table, const std::string& spec) {
+  struct Column {
+    int index = 0;
+    std::string unit, title;
+  };
+  std::vector<Column> columns;
+  if (spec.empty()) {
+    for (size_t i = 0; i < table.header.size(); ++i) columns.push_back({static_cast<int>(i), "", table.header[i]});
+  }
+  size_t at = 0;
+  while (!spec.empty() && at <= spec.size()) {
+    const size_t comma = std::min(spec.find(',', at), spec.size());
+    const std::string part = spec.substr(at, comma - at);
+    const size_t colon = part.find(':');
+    const size_t second = colon == std::string::npos ? std::string::npos : part.find(':', colon + 1);
+    const std::string name = part.substr(0, colon);
+    Column column{table.RequireColumn(name), "", name};
+    if (colon != std::string::npos) column.unit = part.substr(colon + 1, second == std::string::npos ? second : second - colon - 1);
+    if (second != std::string::npos) column.title = part.substr(second + 1);
+    columns.push_back(column);
+    at = comma + 1;
+  }
+  std::string markdown = "|", rule = "|";
+  for (const Column& c : columns) markdown += " " + c.title + " |", rule += " --- |";
+  markdown += "\n" + rule + "\n";
+  for (const std::vector<std::string>& row : table.rows) {
+    markdown += "|";
+    for (const Column& c : columns) {
+      const std::string& cell = row[static_cast<size_t>(c.index)];
+      double number = 0.0;
+      markdown += " " + (ParseNumber(cell, &number) ? FormatFigure(number, c.unit) : cell) + " |";
+    }
+    markdown += "\n";
+  }
+  markdown.pop_back();  // the field's own line ends it
+  return markdown;
+}
+
+}  // namespace
 
 std::string FillResultsPage(const std::string& page_template, const std::string& template_name,
                             const MeasuredFigures& figures) {
@@ -162,7 +215,15 @@ std::string FillResultsPage(const std::string& page_template, const std::string&
     const size_t bar = field.find('|');
     const std::string key = field.substr(0, bar);
     const std::string unit = bar == std::string::npos ? "" : field.substr(bar + 1);
-    if (const auto number = figures.numbers.find(key); number != figures.numbers.end()) {
+    if (key.rfind("csv:", 0) == 0) {
+      const auto table = figures.tables.find(key.substr(4));
+      if (table == figures.tables.end()) ThrowInputError("{}:{}: no table {} was measured", template_name, line, key.substr(4));
+      try {
+        page += MarkdownTable(table->second, unit);
+      } catch (const InputError& e) {
+        ThrowInputError("{}:{}: {}: {}", template_name, line, key, e.what());
+      }
+    } else if (const auto number = figures.numbers.find(key); number != figures.numbers.end()) {
       try {
         page += FormatFigure(number->second, unit);
       } catch (const InputError& e) {

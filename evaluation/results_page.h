@@ -7,10 +7,14 @@
 //   test/<key>                                  what a recording test recorded with
 //                                               RecordProperty (gtest's JSON output)
 //   <run>/<key>                                 a figures.json of daylit replay or estimate
-//                                               (evaluation::RunReport), <run> its name
+//                                               (evaluation::RunReport), <run> its name;
+//                                               nested objects as <run>/<key>/<key>
+// and a table is `{{csv:<path>}}` or `{{csv:<path>|column:unit:title,...}}`: a CSV file under
+// the measured folder as a Markdown table, all its columns or the ones named, each numeric cell
+// in the column's unit (as above) and under its title (default: the column's name).
 // Units: s, ms, us (a time in seconds), /s (a time's inverse: per second), % (a fraction), k and
-// M (thousands, millions); none
-// writes the number as it is. Numbers get three significant digits.
+// M (thousands, millions); none writes the number as it is. Numbers get three significant
+// digits, except whole numbers without a unit (counts: frames, lights), written exactly.
 #pragma once
 
 #include <filesystem>
@@ -19,28 +23,33 @@
 
 #include <nlohmann/json.hpp>
 
+#include "base/csv.h"
+
 namespace daylit::evaluation {
 
 struct MeasuredFigures {
   std::map<std::string, double> numbers;
   std::map<std::string, std::string> texts;
+  std::map<std::string, CsvTable> tables;  // by path under the measured folder
 };
 
 // Google Benchmark's --benchmark_out JSON. Throws InputError naming `source` if it is not one.
 void AddBenchmarkFigures(const nlohmann::json& json, const std::string& source, MeasuredFigures* figures);
 // gtest's --gtest_output=json: the properties whose key has a '/', under test/<key>.
 void AddTestFigures(const nlohmann::json& json, const std::string& source, MeasuredFigures* figures);
-// A flat JSON object (figures.json), under <prefix>/<key>.
+// A JSON object (figures.json), under <prefix>/<key>; nested objects under <prefix>/<key>/<key>,
+// null as the text "none"; arrays (a fit's lights, coefficients) are not figures and are left out.
 void AddRunFigures(const nlohmann::json& json, const std::string& prefix, const std::string& source,
                    MeasuredFigures* figures);
 
 // Every *.json under `folder`, each by what it is: Google Benchmark's output, gtest's, or a
 // figures object under the prefix of its path ("courtyard-a/replay/figures.json" and
-// "courtyard-a/replay.json" both give courtyard-a/replay/<key>). Throws InputError naming a
-// file that is not JSON.
+// "courtyard-a/replay.json" both give courtyard-a/replay/<key>); and every *.csv as a table.
+// Throws InputError naming a file that is not JSON or CSV.
 MeasuredFigures LoadMeasuredFigures(const std::filesystem::path& folder);
 
-// `value` in `unit` with three significant digits ("1.52", "33.6", "143", "25 100").
+// `value` in `unit` with three significant digits ("1.52", "33.6", "143", "25100"); a whole
+// number without a unit exactly ("600").
 std::string FormatFigure(double value, const std::string& unit);
 
 // The template with every field filled. Throws InputError naming the template's line and the

@@ -60,9 +60,28 @@ TEST(ResultsPage, FillsFieldsInTheirUnits) {
             "sky 2.13%, worst pillar_2, 41.2 fps on llvmpipe (LLVM 15.0.6, 256 bits); draw 180 us\n");
 }
 
+TEST(ResultsPage, NestedFiguresAndCsvTables) {
+  MeasuredFigures figures;
+  AddRunFigures(nlohmann::json::parse(R"({"threshold": 0.05, "io": {"n": 3, "mean_error": 0.0368}, "mediancut": null,
+                                          "lights": [1, 2]})"),
+                "lights/galileo/automatic", "automatic.json", &figures);
+  figures.tables["bursts.csv"] = ParseCsv("burst,first_frame,sky_error_r\n0,0,0.0213\n1,100,0.118\n", "bursts.csv");
+  EXPECT_EQ(FillResultsPage("{{lights/galileo/automatic/io/n}} lights ({{lights/galileo/automatic/io/mean_error|%}}%), "
+                            "median cut: {{lights/galileo/automatic/mediancut}}\n"
+                            "{{csv:bursts.csv|burst,sky_error_r:%:E_sky red (%)}}\n",
+                            "t", figures),
+            "3 lights (3.68%), median cut: none\n"
+            "| burst | E_sky red (%) |\n| --- | --- |\n| 0 | 2.13 |\n| 1 | 11.8 |\n");
+  EXPECT_EQ(FillResultsPage("{{csv:bursts.csv}}", "t", figures),
+            "| burst | first_frame | sky_error_r |\n| --- | --- | --- |\n| 0 | 0 | 0.0213 |\n| 1 | 100 | 0.118 |");
+  EXPECT_THROW(FillResultsPage("{{csv:bursts.csv|sun_error_r:%}}", "t", figures), InputError);  // no such column
+  EXPECT_THROW(FillResultsPage("{{csv:other.csv}}", "t", figures), InputError);
+}
+
 TEST(ResultsPage, ThreeSignificantDigits) {
   EXPECT_EQ(FormatFigure(25123.0, "k"), "25.1");
-  EXPECT_EQ(FormatFigure(25123.0, ""), "25100");
+  EXPECT_EQ(FormatFigure(25123.4, ""), "25100");
+  EXPECT_EQ(FormatFigure(25123.0, ""), "25123");  // a count, exactly
   EXPECT_EQ(FormatFigure(0.0123456, ""), "0.0123");
   EXPECT_EQ(FormatFigure(0.1, "%"), "10.0");
   EXPECT_EQ(FormatFigure(0.0, "ms"), "0");

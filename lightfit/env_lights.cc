@@ -9,7 +9,7 @@
 #include "base/error.h"
 #include "sh/exact_irradiance.h"
 #include "lightfit/light_fit.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::lightfit {
 namespace {
@@ -28,14 +28,14 @@ EnvLights::EnvLights(int n, const scene::RayCaster& model, const glm::vec3& obje
   normals_ = FitNormals(n);
   env_size_ = env_width * env_height;
   const int width = std::min(env_width, kFitWidth), height = std::max(1, width / 2);
-  layout_ = scene::HdrImage{width, height, {}};
+  layout_ = HdrImage{width, height, {}};
   // 2×2 rays per fit texel from the objects' centre; each takes the captured texel that shows
   // what it meets.
   std::vector<glm::vec3> origins, dirs;
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
       for (int s = 0; s < 4; ++s) {
-        const glm::dvec3 d = scene::LatLongDirection(u - 0.25 + 0.5 * (s & 1), v - 0.25 + 0.5 * (s >> 1), width, height);
+        const glm::dvec3 d = LatLongDirection(u - 0.25 + 0.5 * (s & 1), v - 0.25 + 0.5 * (s >> 1), width, height);
         origins.push_back(objects_centre), dirs.push_back(glm::normalize(glm::vec3(d)));
       }
     }
@@ -45,7 +45,7 @@ EnvLights::EnvLights(int n, const scene::RayCaster& model, const glm::vec3& obje
   source_.resize(dirs.size());
   for (size_t r = 0; r < dirs.size(); ++r) {
     const glm::vec3 toward = hits[r].IsHit() ? objects_centre + hits[r].t * dirs[r] - capture : dirs[r];
-    source_[r] = static_cast<uint32_t>(scene::LatLongTexel(glm::dvec3(toward), env_width, env_height));
+    source_[r] = static_cast<uint32_t>(LatLongTexel(glm::dvec3(toward), env_width, env_height));
   }
 }
 
@@ -54,7 +54,7 @@ void EnvLights::SetBasis(const relight::EnvBasis& basis) {
   const size_t texels = static_cast<size_t>(layout_.width) * layout_.height;
   for (size_t k = 0; k < 3; ++k) {
     DAYLIT_CHECK(maps[k]->size() == static_cast<size_t>(env_size_), "a basis of {} texels, not {}", maps[k]->size(), env_size_);
-    maps_[k] = scene::HdrImage{layout_.width, layout_.height, std::vector<float>(texels * 3, 0.0f)};
+    maps_[k] = HdrImage{layout_.width, layout_.height, std::vector<float>(texels * 3, 0.0f)};
     for (size_t t = 0; t < texels; ++t) {
       glm::vec3 sum(0.0f);
       for (size_t s = 0; s < 4; ++s) sum += glm::max((*maps[k])[source_[4 * t + s]], glm::vec3(0.0f));
@@ -69,7 +69,7 @@ void EnvLights::FitDirections(const estimation::LightParts& parts) {
   // Irradiance Optimization of the map under this light (all parts alike when there is none).
   std::array<glm::vec3, 3> e = {parts.sun, parts.clear, parts.overcast};
   if (glm::length(e[0]) + glm::length(e[1]) + glm::length(e[2]) <= 0.0f) e.fill(glm::vec3(1.0f));
-  scene::HdrImage mixture{maps_[0].width, maps_[0].height, std::vector<float>(maps_[0].rgb.size(), 0.0f)};
+  HdrImage mixture{maps_[0].width, maps_[0].height, std::vector<float>(maps_[0].rgb.size(), 0.0f)};
   std::vector<glm::dvec3> truth(normals_.size(), glm::dvec3(0.0));
   for (size_t k = 0; k < 3; ++k) {
     for (size_t i = 0; i < mixture.rgb.size(); ++i) mixture.rgb[i] += e[k][static_cast<int>(i % 3)] * maps_[k].rgb[i];

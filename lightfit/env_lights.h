@@ -74,9 +74,9 @@ class EnvLights {
   glm::vec3 objects_centre_;
   std::vector<glm::vec3> normals_;            // FitNormals(n)
   int env_size_ = 0;                          // texels in the captured maps
-  scene::HdrImage layout_;                    // the fit's map size (rgb unused)
+  HdrImage layout_;                    // the fit's map size (rgb unused)
   std::vector<uint32_t> source_;              // per fit texel, 4 captured texels (2×2 rays)
-  std::array<scene::HdrImage, 3> maps_;       // the parts' maps seen from the objects' centre
+  std::array<HdrImage, 3> maps_;       // the parts' maps seen from the objects' centre
   std::array<std::vector<glm::dvec3>, 3> part_truth_;  // their exact irradiance at normals_
   bool stale_ = true;                         // the basis changed since the directions were fitted
   double fit_error_ = 0.0;                    // the error just after the last fit

@@ -10,7 +10,7 @@
 #include "base/check.h"
 #include "base/error.h"
 #include "sh/exact_irradiance.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 #include "scene/scene.h"
 
 namespace daylit::lightfit {
@@ -26,7 +26,7 @@ relight::EnvBasis SyntheticBasis() {
   const glm::dvec3 patch = glm::normalize(glm::dvec3(-0.6, -0.3, -0.5));
   for (int v = 0; v < kHeight; ++v) {
     for (int u = 0; u < kWidth; ++u) {
-      const glm::dvec3 w = scene::LatLongDirection(u, v, kWidth, kHeight);
+      const glm::dvec3 w = LatLongDirection(u, v, kWidth, kHeight);
       const bool sky = w.z > 0.0;
       basis.sun.push_back(glm::dot(w, patch) > std::cos(glm::radians(35.0)) ? glm::vec3(0.030f, 0.026f, 0.022f) : glm::vec3(0.0f));
       const float glow = sky ? static_cast<float>(1.0 + 4.0 * std::pow(std::max(0.0, glm::dot(w, sun)), 8.0)) : 0.0f;
@@ -39,7 +39,7 @@ relight::EnvBasis SyntheticBasis() {
 
 // The mean relative error of `lights` against the exact irradiance of the basis under `parts`.
 double MeanError(const relight::EnvBasis& basis, const estimation::LightParts& parts, const LightSet& lights) {
-  scene::HdrImage map{kWidth, kHeight, {}};
+  HdrImage map{kWidth, kHeight, {}};
   for (size_t t = 0; t < basis.sun.size(); ++t) {
     const glm::vec3 l = parts.sun * basis.sun[t] + parts.clear * basis.clear[t] + parts.overcast * basis.overcast[t];
     map.rgb.insert(map.rgb.end(), {l.x, l.y, l.z});

@@ -235,7 +235,7 @@ std::vector<glm::vec3> FitNormals(int n) {
   return sh::IcosahedronNormals(level);
 }
 
-LightFitResult IrradianceOptimization(const scene::HdrImage& map, int n, const LightFitOptions& options) {
+LightFitResult IrradianceOptimization(const HdrImage& map, int n, const LightFitOptions& options) {
   const std::vector<glm::vec3> normals = FitNormals(n);
   const std::vector<glm::dvec3> truth = sh::ExactIrradiance(map, normals);
   LightSet initial = MedianCutLights(map, n);

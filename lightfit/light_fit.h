@@ -51,7 +51,7 @@ LightFitResult FitLights(const std::vector<glm::vec3>& normals, const std::vecto
 // Irradiance Optimization of a whole probe: N lights started from median cut's N regions
 // (MedianCutLights), the ambient from the irradiance the lights leave unexplained, then fitted
 // to the exact irradiance (sh::ExactIrradiance) at FitNormals(n).
-LightFitResult IrradianceOptimization(const scene::HdrImage& map, int n, const LightFitOptions& options = {});
+LightFitResult IrradianceOptimization(const HdrImage& map, int n, const LightFitOptions& options = {});
 
 // The normals IrradianceOptimization fits at: a subdivided icosahedron with at least 20
 // residuals (3 per normal) per parameter (3 + 5n): 1280 normals up to 32 lights, then 5120.

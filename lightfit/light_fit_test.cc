@@ -96,7 +96,7 @@ TEST(LightFitTest, IrradianceOptimizationNeedsFarFewerLightsThanMedianCutOnRealP
                                                                             {"uffizi-large_1024x512.hdr", 6},
                                                                             {"rooitou_park_1k.hdr", 6},
                                                                             {"potsdamer_platz_1k.hdr", 6}}) {
-    const scene::HdrImage map = scene::ReadHdrImage(std::string(DAYLIT_SOURCE_DIR "/probes/") + file);
+    const HdrImage map = scene::ReadHdrImage(std::string(DAYLIT_SOURCE_DIR "/probes/") + file);
     const std::vector<glm::dvec3> truth = sh::ExactIrradiance(map, normals);
     Reached reached;
     for (int n = 1; n <= io_bar && reached.io == 0; ++n) {
@@ -116,7 +116,7 @@ TEST(LightFitTest, IrradianceOptimizationNeedsFarFewerLightsThanMedianCutOnRealP
 
 TEST(LightFitTest, ConvergesWith64And128Lights) {
   // Seed 002 could not make irradiance optimization converge above 64 lights.
-  const scene::HdrImage map = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/uffizi-large_1024x512.hdr");
+  const HdrImage map = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/uffizi-large_1024x512.hdr");
   const std::vector<glm::vec3> normals = sh::IcosahedronNormals(5);
   const std::vector<glm::dvec3> truth = sh::ExactIrradiance(map, normals);
   for (const int n : {64, 128}) {

@@ -6,7 +6,7 @@
 #include <glm/gtc/constants.hpp>
 #include <nlohmann/json.hpp>
 
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::lightfit {
 namespace {
@@ -58,13 +58,13 @@ std::string LightSetJson(const LightSet& set) {
   return json.dump(2) + "\n";
 }
 
-LightSet MedianCut(const scene::HdrImage& map, int levels) { return MedianCutLights(map, 1 << levels); }
+LightSet MedianCut(const HdrImage& map, int levels) { return MedianCutLights(map, 1 << levels); }
 
-LightSet MedianCutLights(const scene::HdrImage& map, int n) {
+LightSet MedianCutLights(const HdrImage& map, int n) {
   const int w = map.width, h = map.height;
   std::vector<double> luminance(static_cast<size_t>(w) * h);
   for (int v = 0; v < h; ++v) {
-    const double solid_angle = scene::LatLongTexelSolidAngle(v, w, h);
+    const double solid_angle = LatLongTexelSolidAngle(v, w, h);
     for (int u = 0; u < w; ++u) {
       const float* p = map.Pixel(u, v);
       luminance[static_cast<size_t>(v) * w + u] = solid_angle * (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]);
@@ -119,15 +119,15 @@ LightSet MedianCutLights(const scene::HdrImage& map, int n) {
   for (const Region& r : cut) {
     glm::dvec3 power(0.0), centroid(0.0);
     for (int v = r.v0; v < r.v1; ++v) {
-      const double solid_angle = scene::LatLongTexelSolidAngle(v, w, h);
+      const double solid_angle = LatLongTexelSolidAngle(v, w, h);
       for (int u = r.u0; u < r.u1; ++u) {
         const float* p = map.Pixel(u, v);
         const glm::dvec3 texel = solid_angle * glm::dvec3(p[0], p[1], p[2]);
         power += texel;
-        centroid += luminance[static_cast<size_t>(v) * w + u] * scene::LatLongDirection(u, v, w, h);
+        centroid += luminance[static_cast<size_t>(v) * w + u] * LatLongDirection(u, v, w, h);
       }
     }
-    const glm::dvec3 middle = scene::LatLongDirection((r.u0 + r.u1) / 2, (r.v0 + r.v1) / 2, w, h);
+    const glm::dvec3 middle = LatLongDirection((r.u0 + r.u1) / 2, (r.v0 + r.v1) / 2, w, h);
     const glm::dvec3 direction = glm::length(centroid) > 0.0 ? glm::normalize(centroid) : middle;
     set.lights.push_back({glm::vec3(direction), glm::vec3(power)});
   }

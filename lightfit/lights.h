@@ -38,11 +38,11 @@ std::string LightSetJson(const LightSet& set);
 // `levels` times, each region along its longer side (width measured at its middle latitude) where
 // the luminance on both sides is equal; each of the 2^levels regions becomes one light at its
 // luminance-weighted centroid direction carrying the region's whole power Σ L·ΔΩ (RGB). No ambient.
-LightSet MedianCut(const scene::HdrImage& map, int levels);
+LightSet MedianCut(const HdrImage& map, int levels);
 
 // Median cut for any number of lights n ≥ 1: whole levels while 2^levels ≤ n, then the
 // n − 2^levels regions of most power cut once more. For n = 2^levels it is MedianCut.
-LightSet MedianCutLights(const scene::HdrImage& map, int n);
+LightSet MedianCutLights(const HdrImage& map, int n);
 
 // Seed 002's measure over a set of normals: the per-normal relative error |E − E_true| / E_true,
 // averaged over RGB; its mean and max over the normals whose true irradiance is at least 1e-3 of

@@ -5,19 +5,19 @@
 #include <cstdio>
 
 #include "sh/exact_irradiance.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::lightfit {
 namespace {
 
 
 TEST(MedianCutTest, LightsCarryTheMapsPowerAndSplitItEvenly) {
-  const scene::HdrImage map = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
+  const HdrImage map = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
   const LightSet set = MedianCut(map, 4);
   ASSERT_EQ(set.lights.size(), 16u);
   glm::dvec3 total(0.0), lights(0.0);
   for (int v = 0; v < map.height; ++v) {
-    const double solid_angle = scene::LatLongTexelSolidAngle(v, map.width, map.height);
+    const double solid_angle = LatLongTexelSolidAngle(v, map.width, map.height);
     for (int u = 0; u < map.width; ++u) {
       const float* p = map.Pixel(u, v);
       total += solid_angle * glm::dvec3(p[0], p[1], p[2]);
@@ -35,7 +35,7 @@ TEST(MedianCutTest, LightsCarryTheMapsPowerAndSplitItEvenly) {
 }
 
 TEST(MedianCutTest, AnyNumberOfLightsKeepsThePowerAndExtendsTheLevels) {
-  const scene::HdrImage map = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/stpeters_latlong_1024x512.hdr");
+  const HdrImage map = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/stpeters_latlong_1024x512.hdr");
   const LightSet eight = MedianCut(map, 3), five = MedianCutLights(map, 5), also_eight = MedianCutLights(map, 8);
   ASSERT_EQ(five.lights.size(), 5u);
   ASSERT_EQ(also_eight.lights.size(), 8u);
@@ -51,7 +51,7 @@ TEST(MedianCutTest, AnyNumberOfLightsKeepsThePowerAndExtendsTheLevels) {
 TEST(MedianCutTest, ReproducesSeed002sErrorsOnGalileo) {
   // Seed 002, Fig. 2 caption: median cut with 8 lights on Galileo's tomb, about 25% mean and over
   // 75% max per-normal relative error; more lights, less error.
-  const scene::HdrImage map = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
+  const HdrImage map = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
   const std::vector<glm::vec3> normals = sh::IcosahedronNormals(5);
   const std::vector<glm::dvec3> truth = sh::ExactIrradiance(map, normals);
   double previous = 1e9;
@@ -61,7 +61,7 @@ TEST(MedianCutTest, ReproducesSeed002sErrorsOnGalileo) {
                 100 * e.max, e.normals);
     if (levels == 3) {
       // Measured 12.3% mean, 86.8% max: the max as the seed's, the mean half of its ~25%
-      // (docs/relight.md discusses why).
+      // (docs/lightfit.md discusses why).
       EXPECT_GT(e.mean, 0.08);
       EXPECT_LT(e.mean, 0.30);
       EXPECT_GT(e.max, 0.75);

@@ -7,7 +7,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include "base/error.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::lightfit {
 namespace {
@@ -16,7 +16,7 @@ double Luminance(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722
 
 // Bilinear lookup at continuous pixel coordinates (x, y), pixel centres at integers; clamped at
 // the borders.
-glm::dvec3 Bilinear(const scene::HdrImage& image, double x, double y) {
+glm::dvec3 Bilinear(const HdrImage& image, double x, double y) {
   x = std::clamp(x, 0.0, image.width - 1.0), y = std::clamp(y, 0.0, image.height - 1.0);
   const int x0 = std::min(static_cast<int>(x), image.width - 2 < 0 ? 0 : image.width - 2);
   const int y0 = std::min(static_cast<int>(y), image.height - 2 < 0 ? 0 : image.height - 2);
@@ -31,8 +31,8 @@ glm::dvec3 Bilinear(const scene::HdrImage& image, double x, double y) {
 
 }  // namespace
 
-scene::HdrImage AngularToLatLong(const scene::HdrImage& angular, int width, int height) {
-  scene::HdrImage map;
+HdrImage AngularToLatLong(const HdrImage& angular, int width, int height) {
+  HdrImage map;
   map.width = width, map.height = height;
   map.rgb.assign(static_cast<size_t>(width) * height * 3, 0.0f);
   constexpr int kSub = 3;
@@ -41,7 +41,7 @@ scene::HdrImage AngularToLatLong(const scene::HdrImage& angular, int width, int 
       glm::dvec3 sum(0.0);
       for (int sv = 0; sv < kSub; ++sv) {
         for (int su = 0; su < kSub; ++su) {
-          const glm::dvec3 d = scene::LatLongDirection(u - 0.5 + (su + 0.5) / kSub, v - 0.5 + (sv + 0.5) / kSub, width, height);
+          const glm::dvec3 d = LatLongDirection(u - 0.5 + (su + 0.5) / kSub, v - 0.5 + (sv + 0.5) / kSub, width, height);
           // The gallery's frame: forward −Z, up +Y, right +X; daylit's (x, y, z) is its (x, z, −y).
           const double alpha = std::acos(std::clamp(d.y, -1.0, 1.0));  // angle from forward
           const double side = std::hypot(d.x, d.z);
@@ -58,7 +58,7 @@ scene::HdrImage AngularToLatLong(const scene::HdrImage& angular, int width, int 
   return map;
 }
 
-std::string ClippedSourceWarning(const scene::HdrImage& map, int min_texels) {
+std::string ClippedSourceWarning(const HdrImage& map, int min_texels) {
   std::vector<double> luminance(static_cast<size_t>(map.width) * map.height);
   for (int v = 0; v < map.height; ++v) {
     for (int u = 0; u < map.width; ++u) luminance[static_cast<size_t>(v) * map.width + u] = Luminance(map.Pixel(u, v));
@@ -76,7 +76,7 @@ std::string ClippedSourceWarning(const scene::HdrImage& map, int min_texels) {
 
 Probe LoadProbe(const std::filesystem::path& path) {
   Probe probe;
-  const scene::HdrImage image = scene::ReadHdrImage(path);
+  const HdrImage image = scene::ReadHdrImage(path);
   const std::string name = path.string();
   if (image.width == image.height) {
     scene::CheckRadianceValues(image, name);

@@ -13,7 +13,7 @@
 namespace daylit::lightfit {
 
 struct Probe {
-  scene::HdrImage map;                // lat-long, 2:1
+  HdrImage map;                // lat-long, 2:1
   bool converted_from_angular = false;
   std::vector<std::string> warnings;  // for the caller to log
 };
@@ -27,13 +27,13 @@ Probe LoadProbe(const std::filesystem::path& path);
 // linear in the angle from forward, the rim is straight back) resampled to a width × height
 // lat-long map in daylit's frame, in which the gallery's forward is +Y and its up +Z. Each texel
 // averages 3×3 bilinear samples.
-scene::HdrImage AngularToLatLong(const scene::HdrImage& angular, int width, int height);
+HdrImage AngularToLatLong(const HdrImage& angular, int width, int height);
 
 // A warning when the map's brightest source looks clipped: at least `min_texels` texels exactly at
 // the peak luminance while the peak is over 50 times the median (a bright, flat-topped source: a
 // saturated sun or lamp, whose irradiance is then too low). Empty when it does not. An unclipped
 // peak is one texel; RGBE's 0.4% steps put up to 6 texels of Uffizi's bright sky on one value, a
 // sun clipped a thousandfold on a 1024×512 map 30 or more.
-std::string ClippedSourceWarning(const scene::HdrImage& map, int min_texels = 12);
+std::string ClippedSourceWarning(const HdrImage& map, int min_texels = 12);
 
 }  // namespace daylit::lightfit

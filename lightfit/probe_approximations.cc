@@ -42,7 +42,7 @@ std::optional<Method> ParseMethod(const std::string& key) {
   return std::nullopt;
 }
 
-ProbeApproximations::ProbeApproximations(const scene::HdrImage& map, const LightFitOptions& fit)
+ProbeApproximations::ProbeApproximations(const HdrImage& map, const LightFitOptions& fit)
     : map_(map), fit_(fit), normals_(sh::IcosahedronNormals(5)), truth_(sh::ExactIrradiance(map, normals_)) {}
 
 const LightsApproximation& ProbeApproximations::Lights(Method method, int n) {

@@ -48,7 +48,7 @@ struct Sh9Approximation {
 class ProbeApproximations {
  public:
   // `map` (lat-long, linear) is kept by reference.
-  ProbeApproximations(const scene::HdrImage& map, const LightFitOptions& fit);
+  ProbeApproximations(const HdrImage& map, const LightFitOptions& fit);
 
   // `method` (not kSh9) with `n` lights, 1 ≤ n ≤ MaxLights(method) (a broken caller otherwise:
   // CHECK); fitted once, then looked up.
@@ -64,7 +64,7 @@ class ProbeApproximations {
   std::vector<const LightsApproximation*> Fitted(Method method) const;
 
  private:
-  const scene::HdrImage& map_;
+  const HdrImage& map_;
   LightFitOptions fit_;
   std::vector<glm::vec3> normals_;
   std::vector<glm::dvec3> truth_;

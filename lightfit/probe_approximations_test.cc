@@ -7,18 +7,18 @@
 
 #include "base/check.h"
 #include "lightfit/probe_approximations.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::lightfit {
 namespace {
 
 // A sky of radiance 1 over a ground of 0.3, with two bright patches: lights are needed for them.
-scene::HdrImage TwoSunSky(int width) {
-  scene::HdrImage map{width, width / 2, std::vector<float>(static_cast<size_t>(width) * width / 2 * 3)};
+HdrImage TwoSunSky(int width) {
+  HdrImage map{width, width / 2, std::vector<float>(static_cast<size_t>(width) * width / 2 * 3)};
   const glm::dvec3 a = glm::normalize(glm::dvec3(0.5, 0.2, 0.8)), b = glm::normalize(glm::dvec3(-0.6, -0.3, 0.4));
   for (int v = 0; v < map.height; ++v) {
     for (int u = 0; u < map.width; ++u) {
-      const glm::dvec3 d = scene::LatLongDirection(u, v, map.width, map.height);
+      const glm::dvec3 d = LatLongDirection(u, v, map.width, map.height);
       float l = d.z > 0.0 ? 1.0f : 0.3f;
       if (glm::dot(d, a) > std::cos(glm::radians(6.0))) l += 200.0f;
       if (glm::dot(d, b) > std::cos(glm::radians(8.0))) l += 60.0f;
@@ -30,7 +30,7 @@ scene::HdrImage TwoSunSky(int width) {
 }
 
 TEST(ProbeApproximationsTest, AutomaticNIsTheSmallestNUnderTheThreshold) {
-  const scene::HdrImage map = TwoSunSky(128);
+  const HdrImage map = TwoSunSky(128);
   for (const Method method : {Method::kMedianCut, Method::kIrradianceOptimization}) {
     ProbeApproximations table(map, {});
     const double threshold = 0.05;
@@ -49,7 +49,7 @@ TEST(ProbeApproximationsTest, AutomaticNIsTheSmallestNUnderTheThreshold) {
 }
 
 TEST(ProbeApproximationsTest, FitsAreCachedAndListedInOrder) {
-  const scene::HdrImage map = TwoSunSky(64);
+  const HdrImage map = TwoSunSky(64);
   ProbeApproximations table(map, {});
   const LightsApproximation& four = table.Lights(Method::kMedianCut, 4);
   table.Lights(Method::kMedianCut, 1);
@@ -65,10 +65,10 @@ TEST(ProbeApproximationsTest, FitsAreCachedAndListedInOrder) {
 TEST(ProbeApproximationsTest, Sh9IsExactForAnSh9MapAndOutOfRangeIsABrokenInvariant) {
   // Radiance 1 + 0.5·z is in SH's first two bands: its irradiance is represented exactly, up to
   // the map's quadrature.
-  scene::HdrImage map{128, 64, std::vector<float>(128 * 64 * 3)};
+  HdrImage map{128, 64, std::vector<float>(128 * 64 * 3)};
   for (int v = 0; v < map.height; ++v) {
     for (int u = 0; u < map.width; ++u) {
-      const float l = static_cast<float>(1.0 + 0.5 * scene::LatLongDirection(u, v, map.width, map.height).z);
+      const float l = static_cast<float>(1.0 + 0.5 * LatLongDirection(u, v, map.width, map.height).z);
       float* p = map.Pixel(u, v);
       p[0] = p[1] = p[2] = l;
     }

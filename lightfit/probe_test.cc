@@ -10,7 +10,7 @@
 #include "base/error.h"
 #include "sh/exact_irradiance.h"
 #include "lightfit/lights.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::lightfit {
 namespace {
@@ -23,14 +23,14 @@ fs::path TempDir() {
   return dir;
 }
 
-fs::path WriteImage(const std::string& name, const scene::HdrImage& image) {
+fs::path WriteImage(const std::string& name, const HdrImage& image) {
   const fs::path path = TempDir() / name;
   scene::WriteRgbExr(path, image.width, image.height, image.rgb.data());
   return path;
 }
 
-scene::HdrImage Constant(int width, int height, float value) {
-  scene::HdrImage image;
+HdrImage Constant(int width, int height, float value) {
+  HdrImage image;
   image.width = width, image.height = height;
   image.rgb.assign(static_cast<size_t>(width) * height * 3, value);
   return image;
@@ -52,19 +52,19 @@ TEST(ProbeTest, AngularMapLandsInDaylitsFrame) {
   const int size = 400;
   for (const auto& [px, py, expected] : std::vector<std::tuple<int, int, glm::dvec3>>{
            {size / 2, size / 4, {0, 0, 1}}, {3 * size / 4, size / 2, {1, 0, 0}}, {size / 2, size / 2, {0, 1, 0}}}) {
-    scene::HdrImage angular = Constant(size, size, 0.01f);
+    HdrImage angular = Constant(size, size, 0.01f);
     for (int dy = -1; dy <= 0; ++dy) {
       for (int dx = -1; dx <= 0; ++dx) {
         float* p = angular.Pixel(px + dx, py + dy);
         p[0] = p[1] = p[2] = 1000.0f;
       }
     }
-    const scene::HdrImage map = AngularToLatLong(angular, 512, 256);
+    const HdrImage map = AngularToLatLong(angular, 512, 256);
     size_t brightest = 0;
     for (size_t i = 0; i < map.rgb.size() / 3; ++i) {
       if (map.rgb[3 * i] > map.rgb[3 * brightest]) brightest = i;
     }
-    const glm::dvec3 d = scene::LatLongDirection(static_cast<double>(brightest % 512), static_cast<double>(brightest / 512), 512, 256);
+    const glm::dvec3 d = LatLongDirection(static_cast<double>(brightest % 512), static_cast<double>(brightest / 512), 512, 256);
     EXPECT_GT(glm::dot(d, expected), std::cos(glm::radians(1.5))) << "dot at (" << px << ", " << py << ") lands at ("
                                                                   << d.x << ", " << d.y << ", " << d.z << ")";
   }
@@ -97,7 +97,7 @@ TEST(ProbeTest, RealProbesLoadWithoutWarnings) {
 TEST(ProbeTest, AClippedSunIsAWarning) {
   // Rooitou Park's sun, cut at a thousandth of its peak, as when the shortest exposure of a
   // bracket still saturates on the sun.
-  scene::HdrImage map = LoadProbe(DAYLIT_SOURCE_DIR "/probes/rooitou_park_1k.hdr").map;
+  HdrImage map = LoadProbe(DAYLIT_SOURCE_DIR "/probes/rooitou_park_1k.hdr").map;
   float peak = 0.0f;
   for (const float v : map.rgb) peak = std::max(peak, v);
   for (float& v : map.rgb) v = std::min(v, 1e-3f * peak);
@@ -110,7 +110,7 @@ TEST(ProbeTest, AClippedSunIsAWarning) {
 }
 
 TEST(ProbeTest, BadValuesAndShapesAreErrorsNamingTheFile) {
-  scene::HdrImage nan = Constant(64, 32, 1.0f);
+  HdrImage nan = Constant(64, 32, 1.0f);
   nan.Pixel(5, 7)[1] = std::numeric_limits<float>::quiet_NaN();
   nan.Pixel(6, 7)[0] = std::numeric_limits<float>::infinity();
   const std::string nan_error = ErrorOf(WriteImage("nan.exr", nan));
@@ -118,7 +118,7 @@ TEST(ProbeTest, BadValuesAndShapesAreErrorsNamingTheFile) {
   EXPECT_NE(nan_error.find("2 texel values are NaN or infinite"), std::string::npos) << nan_error;
   EXPECT_NE(nan_error.find("(u 5, v 7)"), std::string::npos) << nan_error;
 
-  scene::HdrImage negative = Constant(64, 64, 1.0f);  // square: an angular map, still checked
+  HdrImage negative = Constant(64, 64, 1.0f);  // square: an angular map, still checked
   negative.Pixel(10, 20)[2] = -0.5f;
   const std::string negative_error = ErrorOf(WriteImage("negative.exr", negative));
   EXPECT_NE(negative_error.find("1 are negative, first at (u 10, v 20)"), std::string::npos) << negative_error;

@@ -8,7 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "report/plot.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::relight {
 
@@ -23,7 +23,7 @@ EnvRelighter::EnvRelighter(const bake::SceneBake& bake, const glm::vec3& capture
       const uint32_t t = static_cast<uint32_t>(v) * static_cast<uint32_t>(env.width) + static_cast<uint32_t>(u);
       if (!env.IsSky(t)) continue;
       sky_texels_.push_back(t);
-      sky_dirs_.push_back(glm::vec3(scene::LatLongDirection(u, v, env.width, env.height)));
+      sky_dirs_.push_back(glm::vec3(LatLongDirection(u, v, env.width, env.height)));
     }
   }
 }
@@ -90,7 +90,7 @@ cv::Mat Preview(int width, int height, const std::vector<glm::vec3>& radiance, f
   return preview;
 }
 
-std::vector<glm::vec3> RadianceOf(const scene::HdrImage& image) {
+std::vector<glm::vec3> RadianceOf(const HdrImage& image) {
   std::vector<glm::vec3> out(static_cast<size_t>(image.width) * image.height);
   for (size_t i = 0; i < out.size(); ++i) out[i] = glm::vec3(image.rgb[3 * i], image.rgb[3 * i + 1], image.rgb[3 * i + 2]);
   return out;
@@ -99,7 +99,7 @@ std::vector<glm::vec3> RadianceOf(const scene::HdrImage& image) {
 }  // namespace
 
 EnvComparison CompareEnvMaps(const bake::EnvMapMaps& env, const std::vector<glm::vec3>& relit,
-                             const scene::HdrImage& truth) {
+                             const HdrImage& truth) {
   const std::vector<glm::vec3> want = RadianceOf(truth);
   std::vector<float> luminance;
   for (size_t t = 0; t < want.size(); ++t) {
@@ -110,11 +110,11 @@ EnvComparison CompareEnvMaps(const bake::EnvMapMaps& env, const std::vector<glm:
   EnvComparison cmp;
   double sum = 0.0;
   for (int v = 0; v < env.height; ++v) {
-    const double solid_angle = scene::LatLongTexelSolidAngle(v, env.width, env.height);
+    const double solid_angle = LatLongTexelSolidAngle(v, env.width, env.height);
     for (int u = 0; u < env.width; ++u) {
       const size_t t = static_cast<size_t>(v) * env.width + u;
       if (env.IsSky(t)) {
-        const double cos_theta = scene::LatLongDirection(u, v, env.width, env.height).z;
+        const double cos_theta = LatLongDirection(u, v, env.width, env.height).z;
         if (cos_theta <= 0.0) continue;
         cmp.sky_dhi += solid_angle * cos_theta * Luminance(relit[t]);
         cmp.true_sky_dhi += solid_angle * cos_theta * Luminance(want[t]);
@@ -131,7 +131,7 @@ EnvComparison CompareEnvMaps(const bake::EnvMapMaps& env, const std::vector<glm:
 }
 
 void WriteEnvComparison(const std::filesystem::path& png, const bake::EnvMapMaps& env,
-                        const std::vector<glm::vec3>& relit, const scene::HdrImage& truth) {
+                        const std::vector<glm::vec3>& relit, const HdrImage& truth) {
   const int w = env.width, h = env.height;
   const std::vector<glm::vec3> want = RadianceOf(truth);
   std::vector<float> luminance(want.size());

@@ -79,11 +79,11 @@ struct EnvComparison {
   size_t surface_texels = 0;
 };
 EnvComparison CompareEnvMaps(const bake::EnvMapMaps& env, const std::vector<glm::vec3>& relit,
-                             const scene::HdrImage& truth);
+                             const HdrImage& truth);
 
 // truth | relit | relative difference (blue −25% … white 0 … red +25%), stacked, as a PNG.
 void WriteEnvComparison(const std::filesystem::path& png, const bake::EnvMapMaps& env,
-                        const std::vector<glm::vec3>& relit, const scene::HdrImage& truth);
+                        const std::vector<glm::vec3>& relit, const HdrImage& truth);
 
 // Writes `radiance` (width × height) as a float EXR and a tone-mapped PNG preview next to it
 // (same name, .png), each through a temporary name.

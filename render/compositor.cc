@@ -395,13 +395,20 @@ const Compositor::Rect& Compositor::objects_rect() const { return gl_->rect; }
 int Compositor::height() const { return gl_->height; }
 
 void Compositor::Render(const CompositeInput& input, float* image) {
-  Gl& g = *gl_;
-  const Rect& r = g.rect;
-  if (r.width == 0) return;  // no objects in view
+  if (gl_->rect.width == 0) return;  // no objects in view
   const glm::vec3 sun = glm::normalize(input.sun_dir);
-  const bool sun_up = sun.z > 0.0f;
-  // The sun's shadow map, redrawn for another sun (scene::SunTracker says when it moved).
-  if (sun_up && (!g.has_shadow_map || sun != g.shadow_sun)) {
+  UpdateShadowMaps(input, sun);
+  if (input.volume != nullptr) UpdateVertexLight(*input.volume);
+  DrawObjects(input, sun);
+  BlendOver(image);
+}
+
+// The sun's shadow map, redrawn for another sun (scene::SunTracker says when it moved); the
+// lights' shadow maps, redrawn when their directions change. A light that stands for the real
+// model's reflected light is shadowed by the objects only.
+void Compositor::UpdateShadowMaps(const CompositeInput& input, const glm::vec3& sun) {
+  Gl& g = *gl_;
+  if (sun.z > 0.0f && (!g.has_shadow_map || sun != g.shadow_sun)) {
     g.has_shadow_map = true;
     g.shadow_sun = sun;
     const ShadowView view = ShadowViewOf(sun, g.objects_lo, g.objects_hi, g.model_lo, g.model_hi, g.options.shadow_map_size);
@@ -411,55 +418,58 @@ void Compositor::Render(const CompositeInput& input, float* image) {
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, g.shadow_map.get(), 0);
     DrawShadowMap(g.depth, view, g.options.shadow_map_size, &g.model, g.objects);
   }
-  // The lights' shadow maps, redrawn when their directions change. A light that stands for the
-  // real model's reflected light is shadowed by the objects only.
   const int light_count = input.lights != nullptr ? static_cast<int>(input.lights->lights.size()) : 0;
   DAYLIT_CHECK(light_count == 0 || light_count == g.options.lights, "{} lights given, made for {}", light_count,
                g.options.lights);
-  if (light_count > 0 && input.lights_generation != g.light_generation) {
-    const int size = g.options.light_shadow_map_size;
-    g.light_generation = input.lights_generation;
-    g.light_shadow_from_world.resize(static_cast<size_t>(light_count));
-    g.light_texel.resize(static_cast<size_t>(light_count));
-    glBindFramebuffer(GL_FRAMEBUFFER, g.shadow.get());
-    for (int i = 0; i < light_count; ++i) {
-      const glm::vec3 dir = glm::normalize(input.lights->lights[i].direction);
-      const ShadowView view = ShadowViewOf(dir, g.objects_lo, g.objects_hi, g.model_lo, g.model_hi, size);
-      g.light_shadow_from_world[i] = view.shadow_from_world;
-      g.light_texel[i] = view.texel;
-      const bool reflected = input.lights_reflected != nullptr && (*input.lights_reflected)[i] != 0;
-      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, g.light_maps.get(), 0, i);
-      DrawShadowMap(g.depth, view, size, reflected ? nullptr : &g.model, g.objects);
-    }
+  if (light_count == 0 || input.lights_generation == g.light_generation) return;
+  const int size = g.options.light_shadow_map_size;
+  g.light_generation = input.lights_generation;
+  g.light_shadow_from_world.resize(static_cast<size_t>(light_count));
+  g.light_texel.resize(static_cast<size_t>(light_count));
+  glBindFramebuffer(GL_FRAMEBUFFER, g.shadow.get());
+  for (int i = 0; i < light_count; ++i) {
+    const glm::vec3 dir = glm::normalize(input.lights->lights[i].direction);
+    const ShadowView view = ShadowViewOf(dir, g.objects_lo, g.objects_hi, g.model_lo, g.model_hi, size);
+    g.light_shadow_from_world[i] = view.shadow_from_world;
+    g.light_texel[i] = view.texel;
+    const bool reflected = input.lights_reflected != nullptr && (*input.lights_reflected)[i] != 0;
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, g.light_maps.get(), 0, i);
+    DrawShadowMap(g.depth, view, size, reflected ? nullptr : &g.model, g.objects);
   }
-  // The volume's coefficients at every object vertex (trilinear, the corners found once).
-  const bool has_volume = input.volume != nullptr;
-  if (has_volume) {
-    const std::vector<float>& coefficients = input.volume->coefficients();
-    for (DrawMesh& m : g.objects) {
-      if (m.corner_probes.empty()) {
-        m.corner_probes.resize(m.vertices), m.corner_weights.resize(m.vertices);
-        for (size_t v = 0; v < m.vertices; ++v) input.volume->Corners(m.world[v], &m.corner_probes[v], &m.corner_weights[v]);
-      }
-      g.vertex_sh.assign(m.vertices * 27, 0.0f);
-      for (size_t v = 0; v < m.vertices; ++v) {
-        float* out = &g.vertex_sh[v * 27];
-        for (size_t corner = 0; corner < 8; ++corner) {
-          const float w = m.corner_weights[v][corner];
-          if (w == 0.0f) continue;
-          const float* in = &coefficients[m.corner_probes[v][corner] * 27];
-          for (int k = 0; k < 27; ++k) out[k] += w * in[k];
-        }
-      }
-      glBindBuffer(GL_ARRAY_BUFFER, m.sh.get());
-      glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(g.vertex_sh.size() * sizeof(float)), g.vertex_sh.data());
+}
+
+// The volume's coefficients at every object vertex (trilinear, the corners found once).
+void Compositor::UpdateVertexLight(const sh::IrradianceVolume& volume) {
+  Gl& g = *gl_;
+  const std::vector<float>& coefficients = volume.coefficients();
+  for (DrawMesh& m : g.objects) {
+    if (m.corner_probes.empty()) {
+      m.corner_probes.resize(m.vertices), m.corner_weights.resize(m.vertices);
+      for (size_t v = 0; v < m.vertices; ++v) volume.Corners(m.world[v], &m.corner_probes[v], &m.corner_weights[v]);
     }
-    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    g.vertex_sh.assign(m.vertices * 27, 0.0f);
+    for (size_t v = 0; v < m.vertices; ++v) {
+      float* out = &g.vertex_sh[v * 27];
+      for (size_t corner = 0; corner < 8; ++corner) {
+        const float w = m.corner_weights[v][corner];
+        if (w == 0.0f) continue;
+        const float* in = &coefficients[m.corner_probes[v][corner] * 27];
+        for (int k = 0; k < 27; ++k) out[k] += w * in[k];
+      }
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, m.sh.get());
+    glBufferSubData(GL_ARRAY_BUFFER, 0, static_cast<GLsizeiptr>(g.vertex_sh.size() * sizeof(float)), g.vertex_sh.data());
   }
-  // The phantom and the objects over transparent black: the resolved alpha is each pixel's
-  // object coverage, its colour the covered samples' sum over all samples, so the frame is
-  // blended in below as MSAA over a drawn background would (every sample of a pixel shows the
-  // same background) without drawing, uploading or resolving the background.
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
+// The phantom and the objects over transparent black: the resolved alpha is each pixel's
+// object coverage, its colour the covered samples' sum over all samples, so the frame is
+// blended in below as MSAA over a drawn background would (every sample of a pixel shows the
+// same background) without drawing, uploading or resolving the background.
+void Compositor::DrawObjects(const CompositeInput& input, const glm::vec3& sun) {
+  Gl& g = *gl_;
+  const Rect& r = g.rect;
   glBindFramebuffer(GL_FRAMEBUFFER, g.msaa.get());
   glViewport(0, 0, r.width, r.height);
   glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
@@ -472,41 +482,48 @@ void Compositor::Render(const CompositeInput& input, float* image) {
   glUniformMatrix4fv(g.depth.Uniform("clip_from_world"), 1, GL_FALSE, glm::value_ptr(g.clip_from_world));
   Draw(g.model);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glUseProgram(g.object_program->id());
-  glUniformMatrix4fv(g.object_program->Uniform("clip_from_world"), 1, GL_FALSE, glm::value_ptr(g.clip_from_world));
-  glUniformMatrix4fv(g.object_program->Uniform("shadow_from_world"), 1, GL_FALSE, glm::value_ptr(g.shadow_from_world));
-  glUniform3fv(g.object_program->Uniform("sun_dir"), 1, glm::value_ptr(sun));
-  const glm::vec3 sun_rgb = sun_up ? glm::vec3(input.light.sun_rgb) : glm::vec3(0.0f);
-  glUniform3fv(g.object_program->Uniform("sun_rgb"), 1, glm::value_ptr(sun_rgb));
+  const GlProgram& program = *g.object_program;
+  glUseProgram(program.id());
+  glUniformMatrix4fv(program.Uniform("clip_from_world"), 1, GL_FALSE, glm::value_ptr(g.clip_from_world));
+  glUniformMatrix4fv(program.Uniform("shadow_from_world"), 1, GL_FALSE, glm::value_ptr(g.shadow_from_world));
+  glUniform3fv(program.Uniform("sun_dir"), 1, glm::value_ptr(sun));
+  const glm::vec3 sun_rgb = sun.z > 0.0f ? glm::vec3(input.light.sun_rgb) : glm::vec3(0.0f);
+  glUniform3fv(program.Uniform("sun_rgb"), 1, glm::value_ptr(sun_rgb));
   const glm::vec3 sky_rgb(input.light.sky_rgb);
-  glUniform3fv(g.object_program->Uniform("sky_rgb"), 1, glm::value_ptr(sky_rgb));
-  glUniform1f(g.object_program->Uniform("shadow_texel"), g.shadow_texel);
+  glUniform3fv(program.Uniform("sky_rgb"), 1, glm::value_ptr(sky_rgb));
+  glUniform1f(program.Uniform("shadow_texel"), g.shadow_texel);
   glActiveTexture(GL_TEXTURE1);
   glBindTexture(GL_TEXTURE_2D, g.shadow_map.get());
-  glUniform1i(g.object_program->Uniform("shadow_map"), 1);
-  glUniform1i(g.object_program->Uniform("has_volume"), has_volume ? 1 : 0);
+  glUniform1i(program.Uniform("shadow_map"), 1);
+  glUniform1i(program.Uniform("has_volume"), input.volume != nullptr ? 1 : 0);
+  const int light_count = input.lights != nullptr ? static_cast<int>(input.lights->lights.size()) : 0;
   if (light_count > 0) {
     std::vector<glm::vec3> dirs, rgbs;
     for (const lightfit::DirectionalLight& l : input.lights->lights) dirs.push_back(glm::normalize(l.direction)), rgbs.push_back(l.irradiance);
-    glUniform3fv(g.object_program->Uniform("ambient"), 1, glm::value_ptr(input.lights->ambient));
-    glUniform3fv(g.object_program->Uniform("light_dir"), light_count, glm::value_ptr(dirs[0]));
-    glUniform3fv(g.object_program->Uniform("light_rgb"), light_count, glm::value_ptr(rgbs[0]));
-    glUniformMatrix4fv(g.object_program->Uniform("light_shadow_from_world"), light_count, GL_FALSE,
+    glUniform3fv(program.Uniform("ambient"), 1, glm::value_ptr(input.lights->ambient));
+    glUniform3fv(program.Uniform("light_dir"), light_count, glm::value_ptr(dirs[0]));
+    glUniform3fv(program.Uniform("light_rgb"), light_count, glm::value_ptr(rgbs[0]));
+    glUniformMatrix4fv(program.Uniform("light_shadow_from_world"), light_count, GL_FALSE,
                        glm::value_ptr(g.light_shadow_from_world[0]));
-    glUniform1fv(g.object_program->Uniform("light_texel"), light_count, g.light_texel.data());
+    glUniform1fv(program.Uniform("light_texel"), light_count, g.light_texel.data());
     glActiveTexture(GL_TEXTURE2);
     glBindTexture(GL_TEXTURE_2D_ARRAY, g.light_maps.get());
-    glUniform1i(g.object_program->Uniform("light_maps"), 2);
+    glUniform1i(program.Uniform("light_maps"), 2);
   }
   for (const DrawMesh& m : g.objects) {
     // A closed mesh's back faces are hidden by its front ones: not drawing them halves the work.
     if (m.closed) glEnable(GL_CULL_FACE);
-    glUniform3fv(g.object_program->Uniform("albedo"), 1, glm::value_ptr(m.albedo));
+    glUniform3fv(program.Uniform("albedo"), 1, glm::value_ptr(m.albedo));
     Draw(m);
     glDisable(GL_CULL_FACE);
   }
   glBindVertexArray(0);
-  // Resolve, read back, and blend over the image's rectangle, top row first.
+}
+
+// Resolve, read back, and blend over the image's rectangle, top row first.
+void Compositor::BlendOver(float* image) {
+  Gl& g = *gl_;
+  const Rect& r = g.rect;
   glBindFramebuffer(GL_READ_FRAMEBUFFER, g.msaa.get());
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g.resolved.get());
   glBlitFramebuffer(0, 0, r.width, r.height, 0, 0, r.width, r.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);

@@ -78,6 +78,12 @@ class Compositor {
 
  private:
   struct Gl;
+  // Render's steps, in order.
+  void UpdateShadowMaps(const CompositeInput& input, const glm::vec3& sun);
+  void UpdateVertexLight(const sh::IrradianceVolume& volume);
+  void DrawObjects(const CompositeInput& input, const glm::vec3& sun);
+  void BlendOver(float* image);
+
   std::unique_ptr<Gl> gl_;
 };
 

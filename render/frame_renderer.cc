@@ -31,7 +31,7 @@ FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& b
   DAYLIT_CHECK(options.Check().empty(), "{}", options.Check());
   scene::CheckObjectsOutsideModel(objects_model_, caster, scene.file.string());
   if (options.lights == 0 && !bake.gather.directions.empty()) {
-    volume_ = std::make_unique<sh::IrradianceVolume>(bake.gather, sh::ProbesInsideModel(bake.gather, caster));
+    volume_ = std::make_unique<sh::IrradianceVolume>(bake.gather, bake::ProbesInsideModel(bake.gather, caster));
   }
   if (options.lights > 0 && !scene.objects.empty()) {
     if (!scene.envmap) ThrowInputError("{}: --lighting lights:{} needs the scene's envmap", scene.file.string(), options.lights);

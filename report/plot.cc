@@ -75,15 +75,22 @@ std::vector<double> NiceTicks(double lo, double hi, int target) {
   return ticks;
 }
 
-cv::Mat LinePlot::Render() const {
-  cv::Mat image(options_.height, options_.width, CV_8UC3, cv::Scalar(255, 255, 255));
-  // Log axes plot log10 of the values; a value ≤ 0 has none and becomes a gap.
-  const auto log_of = [](double v) { return v > 0.0 ? std::log10(v) : NAN; };
-  std::vector<Series> plotted = series_;
-  for (Series& s : plotted) {
-    if (options_.x_log) std::transform(s.x.begin(), s.x.end(), s.x.begin(), log_of);
-    if (options_.y_log) std::transform(s.y.begin(), s.y.end(), s.y.begin(), log_of);
+namespace {
+
+// The plot's data range and its pixel area: where a value lands.
+struct PlotArea {
+  cv::Rect area;
+  double x0 = 0.0, x1 = 1.0, y0 = 0.0, y1 = 1.0;
+  bool has_data = false;
+
+  cv::Point ToPixel(double x, double y) const {
+    return cv::Point(area.x + static_cast<int>(std::lround((x - x0) / (x1 - x0) * area.width)),
+                     area.y + area.height - static_cast<int>(std::lround((y - y0) / (y1 - y0) * area.height)));
   }
+};
+
+PlotArea AreaOf(const std::vector<Series>& plotted, const PlotOptions& options, int left, int right, int top, int bottom) {
+  PlotArea p;
   double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
   for (const Series& s : plotted) {
     for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
@@ -92,61 +99,68 @@ cv::Mat LinePlot::Render() const {
       y0 = std::min(y0, s.y[i]), y1 = std::max(y1, s.y[i]);
     }
   }
-  const bool has_data = x0 <= x1;
-  if (!has_data) x0 = 0, x1 = 1, y0 = 0, y1 = 1;
-  if (options_.y_from_zero && !options_.y_log) y0 = std::min(y0, 0.0), y1 = std::max(y1, 0.0);
+  p.has_data = x0 <= x1;
+  if (!p.has_data) x0 = 0, x1 = 1, y0 = 0, y1 = 1;
+  if (options.y_from_zero && !options.y_log) y0 = std::min(y0, 0.0), y1 = std::max(y1, 0.0);
   if (x1 == x0) x0 -= 0.5, x1 += 0.5;
   if (y1 == y0) y0 -= 0.5, y1 += 0.5;
   const double pad = 0.05 * (y1 - y0);
-  y0 -= options_.y_from_zero && y0 == 0.0 ? 0.0 : pad;
+  y0 -= options.y_from_zero && y0 == 0.0 ? 0.0 : pad;
   y1 += pad;
-  const cv::Rect area(kLeft, kTop, options_.width - kLeft - kRight, options_.height - kTop - kBottom);
-  const auto to_px = [&](double x, double y) {
-    return cv::Point(area.x + static_cast<int>(std::lround((x - x0) / (x1 - x0) * area.width)),
-                     area.y + area.height - static_cast<int>(std::lround((y - y0) / (y1 - y0) * area.height)));
-  };
-  const std::vector<double> xt = options_.x_log ? LogTicks(x0, x1) : NiceTicks(x0, x1, 10);
-  const std::vector<double> yt = options_.y_log ? LogTicks(y0, y1) : NiceTicks(y0, y1, 6);
+  p.x0 = x0, p.x1 = x1, p.y0 = y0, p.y1 = y1;
+  p.area = cv::Rect(left, top, options.width - left - right, options.height - top - bottom);
+  return p;
+}
+
+// Grid lines and tick labels on both axes, and the frame.
+void DrawAxes(const PlotArea& p, const PlotOptions& options, cv::Mat* image) {
+  const cv::Rect& area = p.area;
+  const std::vector<double> xt = options.x_log ? LogTicks(p.x0, p.x1) : NiceTicks(p.x0, p.x1, 10);
+  const std::vector<double> yt = options.y_log ? LogTicks(p.y0, p.y1) : NiceTicks(p.y0, p.y1, 6);
   const double xstep = xt.size() > 1 ? xt[1] - xt[0] : 1.0, ystep = yt.size() > 1 ? yt[1] - yt[0] : 1.0;
-  const auto x_label = [&](double t) { return options_.x_log ? fmt::format("{:g}", std::pow(10.0, t)) : TickLabel(t, xstep); };
-  const auto y_label = [&](double t) { return options_.y_log ? fmt::format("{:g}", std::pow(10.0, t)) : TickLabel(t, ystep); };
+  const auto x_label = [&](double t) { return options.x_log ? fmt::format("{:g}", std::pow(10.0, t)) : TickLabel(t, xstep); };
+  const auto y_label = [&](double t) { return options.y_log ? fmt::format("{:g}", std::pow(10.0, t)) : TickLabel(t, ystep); };
   for (const double t : yt) {
-    const cv::Point p = to_px(x0, t);
-    cv::line(image, p, {area.x + area.width, p.y}, kGrid, 1);
+    const cv::Point at = p.ToPixel(p.x0, t);
+    cv::line(*image, at, {area.x + area.width, at.y}, kGrid, 1);
     const std::string label = y_label(t);
     int base = 0;
     const cv::Size size = cv::getTextSize(label, kFont, 0.45, 1, &base);
-    cv::putText(image, label, {area.x - size.width - 6, p.y + size.height / 2}, kFont, 0.45, kInk, 1, cv::LINE_AA);
+    cv::putText(*image, label, {area.x - size.width - 6, at.y + size.height / 2}, kFont, 0.45, kInk, 1, cv::LINE_AA);
   }
   for (const double t : xt) {
-    const cv::Point p = to_px(t, y0);
-    cv::line(image, {p.x, area.y}, p, kGrid, 1);
+    const cv::Point at = p.ToPixel(t, p.y0);
+    cv::line(*image, {at.x, area.y}, at, kGrid, 1);
     const std::string label = x_label(t);
     int base = 0;
     const cv::Size size = cv::getTextSize(label, kFont, 0.45, 1, &base);
-    cv::putText(image, label, {p.x - size.width / 2, area.y + area.height + 18}, kFont, 0.45, kInk, 1, cv::LINE_AA);
+    cv::putText(*image, label, {at.x - size.width / 2, area.y + area.height + 18}, kFont, 0.45, kInk, 1, cv::LINE_AA);
   }
-  cv::rectangle(image, area, kInk, 1);
+  cv::rectangle(*image, area, kInk, 1);
+}
+
+void DrawSeries(const PlotArea& p, const std::vector<Series>& plotted, cv::Mat* image) {
   for (const Series& s : plotted) {
     const cv::Scalar color = Bgr(s.rgb);
     if (s.markers_only) {
       for (size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
-        if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) cv::circle(image, to_px(s.x[i], s.y[i]), 3, color, cv::FILLED, cv::LINE_AA);
+        if (std::isfinite(s.x[i]) && std::isfinite(s.y[i])) cv::circle(*image, p.ToPixel(s.x[i], s.y[i]), 3, color, cv::FILLED, cv::LINE_AA);
       }
       continue;
     }
     for (size_t i = 1; i < std::min(s.x.size(), s.y.size()); ++i) {
       if (!std::isfinite(s.y[i - 1]) || !std::isfinite(s.y[i]) || !std::isfinite(s.x[i - 1]) || !std::isfinite(s.x[i])) continue;
       if (s.dashed) {
-        DrawDashed(image, to_px(s.x[i - 1], s.y[i - 1]), to_px(s.x[i], s.y[i]), color);
+        DrawDashed(*image, p.ToPixel(s.x[i - 1], s.y[i - 1]), p.ToPixel(s.x[i], s.y[i]), color);
       } else {
-        cv::line(image, to_px(s.x[i - 1], s.y[i - 1]), to_px(s.x[i], s.y[i]), color, 2, cv::LINE_AA);
+        cv::line(*image, p.ToPixel(s.x[i - 1], s.y[i - 1]), p.ToPixel(s.x[i], s.y[i]), color, 2, cv::LINE_AA);
       }
     }
   }
-  cv::putText(image, options_.title, {kLeft, 24}, kFont, 0.6, kInk, 1, cv::LINE_AA);
-  cv::putText(image, options_.x_label, {area.x + area.width / 2 - 40, options_.height - 8}, kFont, 0.5, kInk, 1, cv::LINE_AA);
-  cv::putText(image, options_.y_label, {6, kTop - 10}, kFont, 0.45, kInk, 1, cv::LINE_AA);
+}
+
+// The legend, top right inside the area: each series' line or marker and its name.
+void DrawLegend(const cv::Rect& area, const std::vector<Series>& plotted, cv::Mat* image) {
   int legend_width = 0;
   for (const Series& s : plotted) {
     int base = 0;
@@ -156,14 +170,35 @@ cv::Mat LinePlot::Render() const {
   for (const Series& s : plotted) {
     const int x = area.x + area.width - legend_width - 44;
     if (s.markers_only) {
-      cv::circle(image, {x + 12, legend_y - 5}, 3, Bgr(s.rgb), cv::FILLED, cv::LINE_AA);
+      cv::circle(*image, {x + 12, legend_y - 5}, 3, Bgr(s.rgb), cv::FILLED, cv::LINE_AA);
     } else {
-      cv::line(image, {x, legend_y - 5}, {x + 24, legend_y - 5}, Bgr(s.rgb), 2, cv::LINE_AA);
+      cv::line(*image, {x, legend_y - 5}, {x + 24, legend_y - 5}, Bgr(s.rgb), 2, cv::LINE_AA);
     }
-    cv::putText(image, s.name, {x + 30, legend_y}, kFont, 0.45, kInk, 1, cv::LINE_AA);
+    cv::putText(*image, s.name, {x + 30, legend_y}, kFont, 0.45, kInk, 1, cv::LINE_AA);
     legend_y += 18;
   }
-  if (!has_data) cv::putText(image, "no data", {area.x + area.width / 2 - 30, area.y + area.height / 2}, kFont, 0.6, kInk, 1);
+}
+
+}  // namespace
+
+cv::Mat LinePlot::Render() const {
+  cv::Mat image(options_.height, options_.width, CV_8UC3, cv::Scalar(255, 255, 255));
+  // Log axes plot log10 of the values; a value ≤ 0 has none and becomes a gap.
+  const auto log_of = [](double v) { return v > 0.0 ? std::log10(v) : NAN; };
+  std::vector<Series> plotted = series_;
+  for (Series& s : plotted) {
+    if (options_.x_log) std::transform(s.x.begin(), s.x.end(), s.x.begin(), log_of);
+    if (options_.y_log) std::transform(s.y.begin(), s.y.end(), s.y.begin(), log_of);
+  }
+  const PlotArea p = AreaOf(plotted, options_, kLeft, kRight, kTop, kBottom);
+  const cv::Rect& area = p.area;
+  DrawAxes(p, options_, &image);
+  DrawSeries(p, plotted, &image);
+  cv::putText(image, options_.title, {kLeft, 24}, kFont, 0.6, kInk, 1, cv::LINE_AA);
+  cv::putText(image, options_.x_label, {area.x + area.width / 2 - 40, options_.height - 8}, kFont, 0.5, kInk, 1, cv::LINE_AA);
+  cv::putText(image, options_.y_label, {6, kTop - 10}, kFont, 0.45, kInk, 1, cv::LINE_AA);
+  DrawLegend(area, plotted, &image);
+  if (!p.has_data) cv::putText(image, "no data", {area.x + area.width / 2 - 30, area.y + area.height / 2}, kFont, 0.6, kInk, 1);
   return image;
 }
 

@@ -7,20 +7,13 @@
 #include <string>
 #include <vector>
 
+#include "base/hdr_image.h"
+
 namespace daylit::scene {
 
 // Relative luminance of linear Rec.709 RGB (the primaries of every image here).
 inline float Luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * rgb[1] + 0.0722f * rgb[2]; }
 
-// RGB float image, row-major, row 0 at the top.
-struct HdrImage {
-  int width = 0;
-  int height = 0;
-  std::vector<float> rgb;  // 3 floats per pixel
-
-  const float* Pixel(int x, int y) const { return &rgb[(static_cast<size_t>(y) * width + x) * 3]; }
-  float* Pixel(int x, int y) { return &rgb[(static_cast<size_t>(y) * width + x) * 3]; }
-};
 
 // Reads R, G, B (or Y, as grey) as 32-bit floats from an OpenEXR file, or decodes a Radiance
 // .hdr with OpenCV. Throws InputError naming the file when it cannot be read.

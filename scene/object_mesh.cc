@@ -127,8 +127,84 @@ const unsigned char* AccessorData(const tinygltf::Model& model, const tinygltf::
   return data.data() + begin;
 }
 
-// A glTF 2.0 file's triangles in its default scene, node transforms applied, turned from glTF's
-// +Y up to the scene's +Z up (x, y, z) → (x, −z, y).
+// A node's local transform: its matrix, or translation · rotation · scale.
+glm::dmat4 NodeTransform(const tinygltf::Node& node) {
+  glm::dmat4 local(1.0);
+  if (node.matrix.size() == 16) {
+    for (int c = 0; c < 4; ++c) {
+      for (int r = 0; r < 4; ++r) local[c][r] = node.matrix[static_cast<size_t>(4 * c + r)];
+    }
+    return local;
+  }
+  if (node.translation.size() == 3) local = glm::translate(local, glm::dvec3(node.translation[0], node.translation[1], node.translation[2]));
+  if (node.rotation.size() == 4) local *= glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
+  if (node.scale.size() == 3) local = glm::scale(local, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
+  return local;
+}
+
+// A primitive's vertex order: its indices, or 0, 1, 2, ... without them.
+std::vector<uint32_t> PrimitiveOrder(const tinygltf::Model& model, const tinygltf::Primitive& primitive, size_t vertices,
+                                     const std::string& where) {
+  std::vector<uint32_t> order;
+  if (primitive.indices < 0) {
+    for (size_t v = 0; v < vertices; ++v) order.push_back(static_cast<uint32_t>(v));
+    return order;
+  }
+  if (static_cast<size_t>(primitive.indices) >= model.accessors.size()) ThrowInputError("{}: indices accessor missing", where);
+  const tinygltf::Accessor& ia = model.accessors[static_cast<size_t>(primitive.indices)];
+  const size_t size = ia.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ? 1
+                      : ia.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2
+                      : ia.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT ? 4 : 0;
+  if (size == 0) ThrowInputError("{}: indices must be unsigned integers", where);
+  size_t stride = 0;
+  const unsigned char* idata = AccessorData(model, ia, size, &stride, where);
+  for (size_t k = 0; k < ia.count; ++k) {
+    uint32_t i = 0;
+    std::memcpy(&i, idata + k * stride, size);  // little-endian, as glTF is
+    if (i >= vertices) ThrowInputError("{}: index {} past the {} vertices", where, i, vertices);
+    order.push_back(i);
+  }
+  return order;
+}
+
+// A triangle primitive under the node's `world` transform, into `mesh` in scene coordinates:
+// glTF's +Y up turned to +Z up, (x, y, z) → (x, −z, y).
+void AddPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& primitive, const glm::dmat4& world,
+                  const std::string& where, Mesh* mesh) {
+  const glm::dmat4 y_up_to_z_up(1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1);  // columns
+  const auto position = primitive.attributes.find("POSITION");
+  if (position == primitive.attributes.end() || position->second < 0 ||
+      static_cast<size_t>(position->second) >= model.accessors.size()) {
+    ThrowInputError("{}: a primitive without POSITION", where);
+  }
+  const tinygltf::Accessor& pa = model.accessors[static_cast<size_t>(position->second)];
+  if (pa.type != TINYGLTF_TYPE_VEC3 || pa.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT) {
+    ThrowInputError("{}: POSITION must be float VEC3", where);
+  }
+  size_t stride = 0;
+  const unsigned char* pdata = AccessorData(model, pa, 12, &stride, where);
+  std::vector<glm::vec3> points(pa.count);
+  for (size_t v = 0; v < pa.count; ++v) {
+    glm::vec3 p;
+    std::memcpy(&p, pdata + v * stride, 12);
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) ThrowInputError("{}: vertex {} is not finite", where, v);
+    points[v] = glm::vec3(y_up_to_z_up * world * glm::dvec4(glm::dvec3(p), 1.0));
+  }
+  const std::vector<uint32_t> order = PrimitiveOrder(model, primitive, points.size(), where);
+  // A mirroring transform turns the winding; keep the faces counter-clockwise from outside.
+  const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+  for (size_t k = 0; k + 2 < order.size(); k += 3) {
+    const glm::vec3 &a = points[order[k]], &b = points[order[k + 1]], &c = points[order[k + 2]];
+    if (mirrored) {
+      AddFlatTriangle(a, c, b, mesh);
+    } else {
+      AddFlatTriangle(a, b, c, mesh);
+    }
+  }
+}
+
+// A glTF 2.0 file's triangles in its default scene, node transforms applied, in scene
+// coordinates (AddPrimitive).
 Mesh LoadGltfMesh(const std::filesystem::path& path) {
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
@@ -138,71 +214,15 @@ Mesh LoadGltfMesh(const std::filesystem::path& path) {
   if (!ok) ThrowInputError("{}: not a glTF 2.0 file ({})", path.string(), error.empty() ? "unreadable" : error.substr(0, error.find('\n')));
   const std::string where = path.string();
   Mesh mesh;
-  const glm::dmat4 y_up_to_z_up(1, 0, 0, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1);  // columns
   std::function<void(int, const glm::dmat4&)> visit = [&](int index, const glm::dmat4& parent) {
     if (index < 0 || static_cast<size_t>(index) >= model.nodes.size()) ThrowInputError("{}: node {} does not exist", where, index);
     const tinygltf::Node& node = model.nodes[static_cast<size_t>(index)];
-    glm::dmat4 local(1.0);
-    if (node.matrix.size() == 16) {
-      for (int c = 0; c < 4; ++c) {
-        for (int r = 0; r < 4; ++r) local[c][r] = node.matrix[static_cast<size_t>(4 * c + r)];
-      }
-    } else {
-      if (node.translation.size() == 3) local = glm::translate(local, glm::dvec3(node.translation[0], node.translation[1], node.translation[2]));
-      if (node.rotation.size() == 4) local *= glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
-      if (node.scale.size() == 3) local = glm::scale(local, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
-    }
-    const glm::dmat4 world = parent * local;
+    const glm::dmat4 world = parent * NodeTransform(node);
     if (node.mesh >= 0) {
       if (static_cast<size_t>(node.mesh) >= model.meshes.size()) ThrowInputError("{}: mesh {} does not exist", where, node.mesh);
       for (const tinygltf::Primitive& primitive : model.meshes[static_cast<size_t>(node.mesh)].primitives) {
         if (primitive.mode != -1 && primitive.mode != TINYGLTF_MODE_TRIANGLES) continue;  // points, lines, strips
-        const auto position = primitive.attributes.find("POSITION");
-        if (position == primitive.attributes.end() || position->second < 0 ||
-            static_cast<size_t>(position->second) >= model.accessors.size()) {
-          ThrowInputError("{}: a primitive without POSITION", where);
-        }
-        const tinygltf::Accessor& pa = model.accessors[static_cast<size_t>(position->second)];
-        if (pa.type != TINYGLTF_TYPE_VEC3 || pa.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT) {
-          ThrowInputError("{}: POSITION must be float VEC3", where);
-        }
-        size_t stride = 0;
-        const unsigned char* pdata = AccessorData(model, pa, 12, &stride, where);
-        std::vector<glm::vec3> points(pa.count);
-        for (size_t v = 0; v < pa.count; ++v) {
-          glm::vec3 p;
-          std::memcpy(&p, pdata + v * stride, 12);
-          if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) ThrowInputError("{}: vertex {} is not finite", where, v);
-          points[v] = glm::vec3(y_up_to_z_up * world * glm::dvec4(glm::dvec3(p), 1.0));
-        }
-        std::vector<uint32_t> order;
-        if (primitive.indices >= 0) {
-          if (static_cast<size_t>(primitive.indices) >= model.accessors.size()) ThrowInputError("{}: indices accessor missing", where);
-          const tinygltf::Accessor& ia = model.accessors[static_cast<size_t>(primitive.indices)];
-          const size_t size = ia.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ? 1
-                              : ia.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 2
-                              : ia.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT ? 4 : 0;
-          if (size == 0) ThrowInputError("{}: indices must be unsigned integers", where);
-          const unsigned char* idata = AccessorData(model, ia, size, &stride, where);
-          for (size_t k = 0; k < ia.count; ++k) {
-            uint32_t i = 0;
-            std::memcpy(&i, idata + k * stride, size);  // little-endian, as glTF is
-            if (i >= points.size()) ThrowInputError("{}: index {} past the {} vertices", where, i, points.size());
-            order.push_back(i);
-          }
-        } else {
-          for (size_t v = 0; v < points.size(); ++v) order.push_back(static_cast<uint32_t>(v));
-        }
-        // A mirroring transform turns the winding; keep the faces counter-clockwise from outside.
-        const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
-        for (size_t k = 0; k + 2 < order.size(); k += 3) {
-          const glm::vec3 &a = points[order[k]], &b = points[order[k + 1]], &c = points[order[k + 2]];
-          if (mirrored) {
-            AddFlatTriangle(a, c, b, &mesh);
-          } else {
-            AddFlatTriangle(a, b, c, &mesh);
-          }
-        }
+        AddPrimitive(model, primitive, world, where, &mesh);
       }
     }
     for (const int child : node.children) visit(child, world);

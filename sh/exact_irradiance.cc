@@ -7,7 +7,7 @@
 
 #include <glm/gtc/constants.hpp>
 
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::sh {
 namespace {
@@ -18,11 +18,11 @@ struct RowSums {
   int width = 0, height = 0;
   std::vector<glm::dvec3> p, p_cos, p_sin;  // (width + 1) per row
 
-  explicit RowSums(const scene::HdrImage& map) : width(map.width), height(map.height) {
+  explicit RowSums(const HdrImage& map) : width(map.width), height(map.height) {
     const size_t stride = static_cast<size_t>(width) + 1;
     p.assign(stride * height, glm::dvec3(0.0)), p_cos = p, p_sin = p;
     for (int v = 0; v < height; ++v) {
-      const double solid_angle = scene::LatLongTexelSolidAngle(v, width, height);
+      const double solid_angle = LatLongTexelSolidAngle(v, width, height);
       for (int u = 0; u < width; ++u) {
         const double alpha = 2.0 * glm::pi<double>() * ((u + 0.5) / width - 0.5);
         const float* l = map.Pixel(u, v);
@@ -48,7 +48,7 @@ struct RowSums {
 
 }  // namespace
 
-std::vector<glm::dvec3> ExactIrradiance(const scene::HdrImage& map, const std::vector<glm::vec3>& normals) {
+std::vector<glm::dvec3> ExactIrradiance(const HdrImage& map, const std::vector<glm::vec3>& normals) {
   // n·ω = cos θn cos θ + sin θn sin θ cos(α − αn). In a row (θ fixed) that is a + b·cos(α − αn),
   // positive on one arc of azimuths around αn, so the row's share of E(n) is
   //   a·Σ_arc P + b·(cos αn·Σ_arc P cos α + sin αn·Σ_arc P sin α),
@@ -127,23 +127,23 @@ std::vector<glm::vec3> IcosahedronNormals(int levels) {
   return normals;
 }
 
-std::vector<glm::dvec3> ExactIrradianceMap(const scene::HdrImage& map, int width, int height) {
+std::vector<glm::dvec3> ExactIrradianceMap(const HdrImage& map, int width, int height) {
   std::vector<glm::vec3> normals(static_cast<size_t>(width) * height);
   for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; ++u) normals[static_cast<size_t>(v) * width + u] = glm::vec3(scene::LatLongDirection(u, v, width, height));
+    for (int u = 0; u < width; ++u) normals[static_cast<size_t>(v) * width + u] = glm::vec3(LatLongDirection(u, v, width, height));
   }
   return ExactIrradiance(map, normals);
 }
 
-scene::HdrImage DownsampleLatLong(const scene::HdrImage& map, int factor) {
-  scene::HdrImage out{map.width / factor, map.height / factor, {}};
+HdrImage DownsampleLatLong(const HdrImage& map, int factor) {
+  HdrImage out{map.width / factor, map.height / factor, {}};
   out.rgb.assign(static_cast<size_t>(out.width) * out.height * 3, 0.0f);
   for (int v = 0; v < out.height; ++v) {
     for (int u = 0; u < out.width; ++u) {
       glm::dvec3 sum(0.0);
       double weight = 0.0;
       for (int dv = 0; dv < factor; ++dv) {
-        const double w = scene::LatLongTexelSolidAngle(v * factor + dv, map.width, map.height);
+        const double w = LatLongTexelSolidAngle(v * factor + dv, map.width, map.height);
         for (int du = 0; du < factor; ++du) {
           const float* p = map.Pixel(u * factor + du, v * factor + dv);
           sum += w * glm::dvec3(p[0], p[1], p[2]), weight += w;

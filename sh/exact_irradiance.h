@@ -9,11 +9,11 @@
 
 #include <glm/glm.hpp>
 
-#include "scene/hdr_image.h"
+#include "base/hdr_image.h"
 
 namespace daylit::sh {
 
-std::vector<glm::dvec3> ExactIrradiance(const scene::HdrImage& map, const std::vector<glm::vec3>& normals);
+std::vector<glm::dvec3> ExactIrradiance(const HdrImage& map, const std::vector<glm::vec3>& normals);
 
 // The centroid directions of the faces of an icosahedron subdivided `levels` times (each level
 // splits every triangle in four, vertices pushed onto the sphere): 20·4^levels unit normals,
@@ -22,11 +22,11 @@ std::vector<glm::vec3> IcosahedronNormals(int levels);
 
 // The irradiance of every texel direction of a width × height lat-long map (row-major): the
 // "irradiance map" of seed 002.
-std::vector<glm::dvec3> ExactIrradianceMap(const scene::HdrImage& map, int width, int height);
+std::vector<glm::dvec3> ExactIrradianceMap(const HdrImage& map, int width, int height);
 
 // `map` box-filtered down by `factor` in both directions (width and height divisible by it).
 // Each new texel holds the solid-angle-weighted mean radiance of the texels it covers, so the
 // map's integrals against smooth kernels (irradiance) change by a fraction of a percent.
-scene::HdrImage DownsampleLatLong(const scene::HdrImage& map, int factor);
+HdrImage DownsampleLatLong(const HdrImage& map, int factor);
 
 }  // namespace daylit::sh

@@ -7,18 +7,18 @@
 #include <glm/gtc/constants.hpp>
 
 #include "bake/sampling.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::sh {
 namespace {
 
 // Texel by texel, the definition itself.
-glm::dvec3 BruteForce(const scene::HdrImage& map, const glm::vec3& n) {
+glm::dvec3 BruteForce(const HdrImage& map, const glm::vec3& n) {
   glm::dvec3 e(0.0);
   for (int v = 0; v < map.height; ++v) {
-    const double solid_angle = scene::LatLongTexelSolidAngle(v, map.width, map.height);
+    const double solid_angle = LatLongTexelSolidAngle(v, map.width, map.height);
     for (int u = 0; u < map.width; ++u) {
-      const double c = glm::dot(glm::dvec3(n), scene::LatLongDirection(u, v, map.width, map.height));
+      const double c = glm::dot(glm::dvec3(n), LatLongDirection(u, v, map.width, map.height));
       if (c <= 0.0) continue;
       const float* p = map.Pixel(u, v);
       e += c * solid_angle * glm::dvec3(p[0], p[1], p[2]);
@@ -29,7 +29,7 @@ glm::dvec3 BruteForce(const scene::HdrImage& map, const glm::vec3& n) {
 
 TEST(ExactIrradianceTest, RowArcsGiveTheTexelByTexelSum) {
   // A rough random map (every texel independent: the worst case for the arc ends).
-  scene::HdrImage map{256, 128, std::vector<float>(256 * 128 * 3)};
+  HdrImage map{256, 128, std::vector<float>(256 * 128 * 3)};
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> radiance(0.0f, 10.0f);
   for (float& x : map.rgb) x = radiance(rng);
@@ -43,7 +43,7 @@ TEST(ExactIrradianceTest, RowArcsGiveTheTexelByTexelSum) {
 }
 
 TEST(ExactIrradianceTest, UniformSkyAndHalfSky) {
-  scene::HdrImage map{512, 256, std::vector<float>(512 * 256 * 3, 1.0f)};
+  HdrImage map{512, 256, std::vector<float>(512 * 256 * 3, 1.0f)};
   const std::vector<glm::dvec3> e = ExactIrradiance(map, {glm::vec3(0, 0, 1), glm::normalize(glm::vec3(1, 2, 3))});
   EXPECT_NEAR(e[0].x, glm::pi<double>(), 1e-4);  // uniform radiance 1: π for every normal
   EXPECT_NEAR(e[1].y, glm::pi<double>(), 1e-4);

@@ -24,7 +24,7 @@ double CosineLobe(int c) {
 
 }  // namespace
 
-IrradianceVolume::IrradianceVolume(const bake::GatherTables& gather, std::vector<uint8_t> inside)
+IrradianceVolume::IrradianceVolume(const sh::GatherTables& gather, std::vector<uint8_t> inside)
     : gather_(gather), inside_(std::move(inside)) {
   const size_t dirs = gather.directions.size();
   inside_.resize(gather.ProbeCount(), 0);
@@ -167,32 +167,5 @@ glm::vec3 IrradianceVolume::Integrate(const glm::vec3& point, const Sh9Basis& y)
   return e;
 }
 
-std::vector<uint8_t> ProbesInsideModel(const bake::GatherTables& gather, const scene::RayCaster& caster) {
-  const size_t dirs = gather.directions.size();
-  const size_t probes = gather.ProbeCount();
-  std::vector<glm::vec3> origins(probes * dirs), rays(probes * dirs);
-  const glm::ivec3 n = gather.resolution;
-  for (int k = 0; k < n.z; ++k) {
-    for (int j = 0; j < n.y; ++j) {
-      for (int i = 0; i < n.x; ++i) {
-        const size_t p = (static_cast<size_t>(k) * n.y + j) * n.x + i;
-        for (size_t d = 0; d < dirs; ++d) origins[p * dirs + d] = gather.ProbePosition(i, j, k), rays[p * dirs + d] = gather.directions[d];
-      }
-    }
-  }
-  std::vector<scene::RayHit> hits(origins.size());
-  caster.IntersectMany(origins.data(), rays.data(), origins.size(), 0.0f, hits.data());
-  std::vector<uint8_t> inside(probes, 0);
-  for (size_t p = 0; p < probes; ++p) {
-    size_t back = 0;
-    for (size_t d = 0; d < dirs; ++d) {
-      // A face through the probe itself (the ground under the volume's floor) says nothing.
-      const scene::RayHit& hit = hits[p * dirs + d];
-      back += hit.IsHit() && hit.back_face && hit.t > 1e-3f ? 1 : 0;
-    }
-    inside[p] = back * 4 > dirs ? 1 : 0;
-  }
-  return inside;
-}
 
 }  // namespace daylit::sh

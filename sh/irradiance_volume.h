@@ -20,17 +20,16 @@
 
 #include <glm/glm.hpp>
 
-#include "bake/bake.h"
+#include "sh/gather_tables.h"
 #include "sh/sh9.h"
-#include "scene/raycaster.h"
 
 namespace daylit::sh {
 
 class IrradianceVolume {
  public:
-  // `inside[p]` marks probes inside the model (ProbesInsideModel): they take the mean of their
+  // `inside[p]` marks probes inside the model (bake::ProbesInsideModel): they take the mean of their
   // valid neighbours after each update instead of the black they would see.
-  explicit IrradianceVolume(const bake::GatherTables& gather, std::vector<uint8_t> inside = {});
+  explicit IrradianceVolume(const GatherTables& gather, std::vector<uint8_t> inside = {});
 
   // Recomputes every probe from the env map's radiance (one RGB per texel, row-major, sun
   // excluded): the gather directions carry 4π/N sr each.
@@ -54,22 +53,18 @@ class IrradianceVolume {
   glm::vec3 ProbeIrradiance(int i, int j, int k, const glm::vec3& normal) const;
 
   const std::vector<float>& coefficients() const { return coefficients_; }
-  const bake::GatherTables& gather() const { return gather_; }
+  const GatherTables& gather() const { return gather_; }
   size_t InsideCount() const;
 
  private:
   glm::vec3 Evaluate(size_t probe, const Sh9Basis& y) const;  // Σ_c coefficient_c · y_c
 
-  const bake::GatherTables& gather_;
+  const GatherTables& gather_;
   std::vector<uint8_t> inside_;
   std::vector<float> basis_;         // [c · N + d]: Â_l · Y_c(direction d) · 4π/N
   std::vector<float> coefficients_;  // layout above
   std::vector<float> gathered_;      // scratch: one probe's radiances, R then G then B
 };
 
-// Probes inside the model: from inside, most gather rays leave through the back of a face; a
-// probe is inside when more than a quarter of its rays do. (A probe exactly on a surface, such
-// as the ground at the volume's floor, is not: it sees the surface as a black half.)
-std::vector<uint8_t> ProbesInsideModel(const bake::GatherTables& gather, const scene::RayCaster& caster);
 
 }  // namespace daylit::sh

@@ -4,8 +4,11 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "bake/bake.h"
 #include "bake/synthetic_recording.h"
 #include "base/log.h"
+#include "scene/raycaster.h"
+#include "scene/scene.h"
 
 namespace daylit::sh {
 namespace {
@@ -29,7 +32,7 @@ struct OpenGround {
 
 TEST(IrradianceVolumeTest, OpenGroundGivesTheHemispheresIrradiance) {
   const OpenGround w("volume_open");
-  IrradianceVolume volume(w.bake.gather, ProbesInsideModel(w.bake.gather, *w.caster));
+  IrradianceVolume volume(w.bake.gather, bake::ProbesInsideModel(w.bake.gather, *w.caster));
   EXPECT_EQ(volume.InsideCount(), 0u);
   volume.Update(w.bake.env.radiance);
   // Sky 1 above, ground 0.4 below: facing up π, facing down 0.4π, sideways 0.7π (SH9 is exact
@@ -75,7 +78,7 @@ TEST(IrradianceVolumeTest, AProbeInsideAWallTakesItsNeighboursValues) {
       "v -1.2 -1.2 0.7\nv -0.8 -1.2 0.7\nv -0.8 -0.8 0.7\nv -1.2 -0.8 0.7\n"
       "f 5 8 7 6\nf 9 10 11 12\nf 5 6 10 9\nf 6 7 11 10\nf 7 8 12 11\nf 8 5 9 12\n";
   const OpenGround w("volume_inside", faces);
-  const std::vector<uint8_t> inside = ProbesInsideModel(w.bake.gather, *w.caster);
+  const std::vector<uint8_t> inside = bake::ProbesInsideModel(w.bake.gather, *w.caster);
   ASSERT_EQ(inside.size(), 8u);
   EXPECT_EQ(inside[0], 1);
   for (size_t p = 1; p < 8; ++p) EXPECT_EQ(inside[p], 0) << p;
@@ -97,7 +100,7 @@ TEST(IrradianceVolumeTest, CombiningUpdatesEqualsUpdatingTheCombinedMap) {
       "v -1.2 -1.2 0.7\nv -0.8 -1.2 0.7\nv -0.8 -0.8 0.7\nv -1.2 -0.8 0.7\n"
       "f 5 8 7 6\nf 9 10 11 12\nf 5 6 10 9\nf 6 7 11 10\nf 7 8 12 11\nf 8 5 9 12\n";
   const OpenGround w("volume_combine", faces);
-  IrradianceVolume volume(w.bake.gather, ProbesInsideModel(w.bake.gather, *w.caster));
+  IrradianceVolume volume(w.bake.gather, bake::ProbesInsideModel(w.bake.gather, *w.caster));
   ASSERT_EQ(volume.InsideCount(), 1u);
   const size_t texels = w.bake.env.radiance.size();
   std::array<std::vector<glm::vec3>, 3> maps;

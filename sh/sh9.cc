@@ -4,7 +4,7 @@
 
 #include <glm/gtc/constants.hpp>
 
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 namespace daylit::sh {
 namespace {
@@ -51,10 +51,10 @@ glm::dvec3 ShRgb9::Radiance(const glm::dvec3& dir) const {
 ShRgb9 ProjectLatLong(const float* rgb, int width, int height) {
   ShRgb9 sh;
   for (int v = 0; v < height; ++v) {
-    const double solid_angle = scene::LatLongTexelSolidAngle(v, width, height);
+    const double solid_angle = LatLongTexelSolidAngle(v, width, height);
     for (int u = 0; u < width; ++u) {
       const float* texel = rgb + (static_cast<size_t>(v) * width + u) * 3;
-      sh.AddRadiance(scene::LatLongDirection(u, v, width, height), glm::dvec3(texel[0], texel[1], texel[2]),
+      sh.AddRadiance(LatLongDirection(u, v, width, height), glm::dvec3(texel[0], texel[1], texel[2]),
                      solid_angle);
     }
   }

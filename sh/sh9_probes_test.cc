@@ -9,6 +9,7 @@
 
 #include "bake/sampling.h"
 #include "sh/exact_irradiance.h"
+#include "scene/hdr_image.h"
 #include "sh/sh9.h"
 
 namespace daylit::sh {
@@ -20,8 +21,8 @@ struct ProbeError {
 };
 
 ProbeError Sh9Error(const std::string& file) {
-  const scene::HdrImage full = scene::ReadHdrImage(std::string(DAYLIT_SOURCE_DIR "/probes/") + file);
-  const scene::HdrImage map = DownsampleLatLong(full, 4);  // 256×128: the irradiance changes < 0.1%
+  const HdrImage full = scene::ReadHdrImage(std::string(DAYLIT_SOURCE_DIR "/probes/") + file);
+  const HdrImage map = DownsampleLatLong(full, 4);  // 256×128: the irradiance changes < 0.1%
   const std::vector<glm::vec3> normals = bake::SphericalFibonacci(2000);
   const std::vector<glm::dvec3> exact = ExactIrradiance(map, normals);
   const ShRgb9 sh = ProjectLatLong(map.rgb.data(), map.width, map.height);

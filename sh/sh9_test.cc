@@ -1,6 +1,6 @@
 #include "sh/sh9.h"
 
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,6 @@
 namespace daylit::sh {
 namespace {
 
-using scene::LatLongDirection;
-using scene::LatLongTexelSolidAngle;
 
 constexpr double kPi = glm::pi<double>();
 

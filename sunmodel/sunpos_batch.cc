@@ -79,7 +79,7 @@ RowInput ParseRow(const CsvTable& table, size_t row, const Columns& c) {
 // Positions of all rows, computed in time order: ERFA's series evaluate ~1500 sin/cos per call,
 // and glibc's sincos branches on the size of its argument, so rows in random time order
 // mispredict those branches and run ~1.5x slower than the same rows sorted
-// (docs/performance.md).
+// (docs/sunmodel.md, "Speed").
 std::vector<SunPosition> ComputeInTimeOrder(const std::vector<RowInput>& inputs) {
   std::vector<size_t> order(inputs.size());
   std::iota(order.begin(), order.end(), size_t{0});

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "bake/bake.h"
@@ -51,11 +52,12 @@ TEST(BakeRecordingTest, AlbedoMatchesGroundTruthAndTheCacheReloads) {
       const double ours = Median(values);
       std::printf("%-16s %c truth %.4f ours %.4f (%+.1f%%)\n", name.c_str(), "RGB"[c], expected, ours,
                   100.0 * (ours / expected - 1.0));
+      testing::RecordFigure(fmt::format("courtyard-a/bake/albedo/{}/{}", name, "rgb"[c]), ours / expected - 1.0);
       EXPECT_NEAR(ours / expected, 1.0, 0.05) << name << " channel " << c;
     }
   }
   // Per pixel, where the truth has albedo and we see a surface.
-  const scene::HdrImage truth_px = scene::ReadHdrImage(recording + "/groundtruth/albedo_camera.exr");
+  const HdrImage truth_px = scene::ReadHdrImage(recording + "/groundtruth/albedo_camera.exr");
   ASSERT_EQ(truth_px.width, g.width);
   std::vector<double> errors;
   for (size_t i = 0; i < g.surface.size(); ++i) {

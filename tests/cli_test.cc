@@ -234,7 +234,7 @@ TEST(CliTest, RelightEnvWritesTheRelitMapAndItsPreview) {
                             " --out " + out.string());
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_TRUE(fs::is_regular_file(rec.dir / "env.png"));
-  const scene::HdrImage env = scene::ReadHdrImage(out);
+  const HdrImage env = scene::ReadHdrImage(out);
   const float linear = static_cast<float>(capture::CameraResponse{}.ToLinear(120.0 / 255.0));
   EXPECT_NEAR(env.Pixel(0, 0)[1], linear / 0.4f, 0.01f * linear / 0.4f);                   // zenith
   EXPECT_NEAR(env.Pixel(10, env.height - 1)[1], linear, 0.02f * linear);                     // ground below
@@ -264,7 +264,7 @@ TEST(CliTest, LightsWritesTheLightsTheirErrorsAndTheAutomaticN) {
   ASSERT_EQ(errors.header, (std::vector<std::string>{"method", "n", "mean_error", "max_error"}));
   // The file's lights, evaluated as its format says (E(n) = ambient + Σ irradiance·max(0, n·d)),
   // give the error the CSV reports against the exact irradiance.
-  const scene::HdrImage map = scene::ReadHdrImage(kProbe);
+  const HdrImage map = scene::ReadHdrImage(kProbe);
   const std::vector<glm::vec3> normals = sh::IcosahedronNormals(5);
   const std::vector<glm::dvec3> truth = sh::ExactIrradiance(map, normals);
   std::map<std::string, double> mean_of;
@@ -385,8 +385,8 @@ TEST(CliTest, RenderWritesTheCompositeAndComparesItWithTheTruth) {
   EXPECT_TRUE(fs::is_regular_file(dir / "f_vs_truth.png"));
   // The EXR is the linear composite in radiance units: where no object or shadow reaches, the
   // frame linearised with its exposure divided out, so within the video's noise of the truth.
-  const scene::HdrImage image = scene::ReadHdrImage(dir / "f.exr");
-  const scene::HdrImage truth = scene::ReadHdrImage(kRecording + "/groundtruth/without_objects/000300.exr");
+  const HdrImage image = scene::ReadHdrImage(dir / "f.exr");
+  const HdrImage truth = scene::ReadHdrImage(kRecording + "/groundtruth/without_objects/000300.exr");
   ASSERT_EQ(image.width, truth.width);
   double ratio = 0.0;
   int n = 0;
@@ -583,8 +583,8 @@ TEST(CliTest, RelightWritesTheRelitFrameItsStripAndAVideo) {
                               (dir / "n.exr").string() + cache);
   ASSERT_EQ(night.exit_code, 0) << night.err;
   EXPECT_NE(night.err.find("below the horizon; a sky-only relight (E_sun = 0)"), std::string::npos) << night.err;
-  const scene::HdrImage dark = scene::ReadHdrImage(dir / "n.exr");
-  const scene::HdrImage truth = scene::ReadHdrImage(kRecording + "/groundtruth/without_objects/000152.exr");
+  const HdrImage dark = scene::ReadHdrImage(dir / "n.exr");
+  const HdrImage truth = scene::ReadHdrImage(kRecording + "/groundtruth/without_objects/000152.exr");
   double dark_sum = 0.0, day_sum = 0.0;
   for (size_t i = 0; i < dark.rgb.size(); ++i) dark_sum += dark.rgb[i], day_sum += truth.rgb[i];
   EXPECT_LT(dark_sum, 0.5 * day_sum);

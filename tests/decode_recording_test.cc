@@ -28,7 +28,7 @@ double Median(std::vector<double> v) {
 }
 
 // Median of decoded / true linear value over pixels whose true value is in [lo, hi).
-double MedianRatio(const cv::Mat& linear_rgb, const scene::HdrImage& truth, double exposure, double lo, double hi) {
+double MedianRatio(const cv::Mat& linear_rgb, const HdrImage& truth, double exposure, double lo, double hi) {
   std::vector<double> ratios;
   for (int y = 0; y < truth.height; ++y) {
     for (int x = 0; x < truth.width; ++x) {
@@ -54,7 +54,7 @@ cv::Mat Linearize(const cv::Mat& encoded_rgb) {
 
 TEST(VideoDecoderTest, DecodesTheRecordingExactly) {
   const scene::Scene scene = scene::LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a");
-  const scene::HdrImage truth = scene::ReadHdrImage(
+  const HdrImage truth = scene::ReadHdrImage(
       fmt::format(DAYLIT_SOURCE_DIR "/recordings/courtyard-a/groundtruth/without_objects/{:06d}.exr", kFrame));
   const double exposure = scene.frame_times->ExposureOf(kFrame, scene.exposure);
 

@@ -64,9 +64,9 @@ TEST(ObjectShadowsRecordingTest, ShadowsAndSkyLossMatchThePathTracer) {
     if (!fs::is_regular_file(with_file)) continue;
     // The truth's E_sun and E_sky; the clouds' share (not in groundtruth.csv) from the fit.
     const double overcast = estimation::FitFrame(scene, c.bake, real, position, {}).fit.overcast_share;
-    const scene::HdrImage with = scene::ReadHdrImage(with_file);
-    scene::HdrImage predicted = scene::ReadHdrImage(gt / "without_objects" / fmt::format("{:06d}.exr", index));
-    const scene::HdrImage without = predicted;
+    const HdrImage with = scene::ReadHdrImage(with_file);
+    HdrImage predicted = scene::ReadHdrImage(gt / "without_objects" / fmt::format("{:06d}.exr", index));
+    const HdrImage without = predicted;
     const cv::Mat mask = cv::imread((gt / "objects_mask" / fmt::format("{:06d}.png", index)).string(), cv::IMREAD_GRAYSCALE);
     const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(time, scene.location, atmosphere, {});
     const glm::vec3 sun_dir(scene.GeoFrame().DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg));

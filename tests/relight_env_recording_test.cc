@@ -32,7 +32,7 @@ TEST(RelightEnvRecordingTest, RelitMapsMatchThePathTracedOnes) {
     relighter.SetSun(fit.sun_dir);
     std::vector<glm::vec3> radiance;
     relighter.Relight(fit.fit.light, fit.fit.overcast_share, &radiance);
-    const scene::HdrImage truth =
+    const HdrImage truth =
         scene::ReadHdrImage(*scene.groundtruth.composites / "envmaps" / fmt::format("{:06d}.exr", frame));
     const relight::EnvComparison cmp = relight::CompareEnvMaps(baked.env, radiance, truth);
     std::printf("frame %d: %.1f%% over %zu surface texels, sky DHI %+.1f%%\n", frame, 100 * cmp.surface_error,

@@ -19,7 +19,7 @@
 #include "estimation/frame_estimator.h"
 #include "relight/env_relight.h"
 #include "sh/irradiance_volume.h"
-#include "scene/latlong.h"
+#include "base/latlong.h"
 #include "scene/scene.h"
 
 namespace daylit {
@@ -34,7 +34,7 @@ TEST(VolumeRecordingTest, CourtyardVolumeMatchesBruteForceIrradiance) {
   relighter.SetSun(fit.sun_dir);
   std::vector<glm::vec3> env;
   relighter.Relight(fit.fit.light, fit.fit.overcast_share, &env);
-  sh::IrradianceVolume volume(baked.gather, sh::ProbesInsideModel(baked.gather, caster));
+  sh::IrradianceVolume volume(baked.gather, bake::ProbesInsideModel(baked.gather, caster));
   volume.Update(env);
   const glm::vec3 capture(scene.envmap->position);
   const int w = baked.env.width, h = baked.env.height;
@@ -62,7 +62,7 @@ TEST(VolumeRecordingTest, CourtyardVolumeMatchesBruteForceIrradiance) {
       const glm::vec3 dir = frame * local;
       const scene::RayHit hit = caster.Intersect(p, dir);
       const glm::dvec3 toward = hit.IsHit() ? glm::dvec3(p + hit.t * dir - capture) : glm::dvec3(dir);
-      sum += glm::dvec3(env[static_cast<size_t>(scene::LatLongTexel(toward, w, h))]);
+      sum += glm::dvec3(env[static_cast<size_t>(LatLongTexel(toward, w, h))]);
     }
     const glm::dvec3 truth = glm::pi<double>() * sum / static_cast<double>(hemisphere.size());
     const glm::dvec3 got(volume.Irradiance(p, n));

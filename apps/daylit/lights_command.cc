@@ -1,6 +1,6 @@
 // daylit lights: a light probe approximated by N directional lights (median cut, irradiance
 // optimization) and by SH9, with seed 002's error measure, the automatic N and the error plot
-// (docs/relight.md).
+// (docs/lightfit.md).
 #include <algorithm>
 #include <filesystem>
 #include <memory>

@@ -78,6 +78,72 @@ nlohmann::json NewSceneJson(const scene::Scene& scene, const capture::RecordingW
   return json;
 }
 
+// The frames to record: the V4L2 camera (the scene's controls, overridden by the options) or
+// the recording `--from`; its frame rate, and how many frames it has if it ends.
+struct RecordSource {
+  std::unique_ptr<capture::FrameSource> source;
+  double fps = 30.0;
+  std::optional<size_t> total;
+};
+
+RecordSource OpenRecordSource(const RecordOptions& o, const scene::Scene& scene) {
+  RecordSource r;
+  if (!o.device.empty()) {
+    capture::V4l2Options v4l2;
+    v4l2.width = scene.intrinsics.width, v4l2.height = scene.intrinsics.height;
+    v4l2.fps = scene.frames.kind == scene::FrameSourceKind::kDevice ? scene.frames.fps : 30.0;
+    if (scene.frames.kind == scene::FrameSourceKind::kDevice) v4l2.settings = scene.frames.controls;
+    if (o.exposure_100us) v4l2.settings.exposure_100us = o.exposure_100us;
+    if (o.gain) v4l2.settings.gain = o.gain;
+    if (o.white_balance_k) v4l2.settings.white_balance_k = o.white_balance_k;
+    v4l2.exposure = scene.exposure;
+    r.source = capture::OpenV4l2Source(o.device, v4l2);
+    r.fps = v4l2.fps;
+  } else {
+    if (!scene.frame_times) ThrowInputError("--from: {} has no recorded frames", o.from);
+    r.source = scene::OpenFrameSource(scene);
+    r.fps = scene::NominalFps(scene);
+    r.total = scene.frame_times->frames.size();
+  }
+  if (o.frames) r.total = r.total ? std::min(*r.total, static_cast<size_t>(*o.frames)) : static_cast<size_t>(*o.frames);
+  return r;
+}
+
+// Frames from `r` into `writer` until the source ends, --frames or --seconds, or Ctrl-C;
+// returns how many were written.
+int CopyFrames(const RecordOptions& o, RecordSource* r, capture::RecordingWriter* writer) {
+  g_stop = false;
+  std::signal(SIGINT, StopRecording);
+  std::signal(SIGTERM, StopRecording);
+  std::optional<Progress> progress;
+  if (r->total) progress.emplace("record", *r->total);
+  std::optional<UtcTime> first;
+  const auto start = std::chrono::steady_clock::now();
+  int written = 0;
+  while (!g_stop && (!o.frames || written < *o.frames)) {
+    capture::Frame frame;
+    const capture::FrameStatus status = r->source->Next(&frame);
+    if (status == capture::FrameStatus::kEnd) break;
+    if (status == capture::FrameStatus::kWaiting) continue;
+    if (status == capture::FrameStatus::kUndecodable) {
+      if (progress) progress->Advance();
+      continue;
+    }
+    if (!first) first = frame.utc;
+    if (o.seconds && frame.utc.SecondsSince(*first) > *o.seconds) break;
+    writer->Write(frame);
+    ++written;
+    if (progress) {
+      progress->Advance();
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      progress->SetSuffix(fmt::format("{:.0f} fps", written / std::max(elapsed, 1e-9)));
+    }
+  }
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  return written;
+}
+
 void RunRecord(const RecordOptions& o) {
   if (o.device.empty() == o.from.empty()) ThrowInputError("record: give exactly one of --device and --from");
   if (o.device.empty() ? false : o.scene.empty()) ThrowInputError("--scene: needed with --device (the model, camera and location)");
@@ -88,71 +154,22 @@ void RunRecord(const RecordOptions& o) {
     ThrowInputError("--out: {} exists; record into a new folder", out.string());
   }
   const scene::Scene scene = scene::LoadScene(o.scene.empty() ? o.from : o.scene);
-  std::unique_ptr<capture::FrameSource> source;
-  double fps = 30.0;
-  std::optional<size_t> total;
-  if (!o.device.empty()) {
-    capture::V4l2Options v4l2;
-    v4l2.width = scene.intrinsics.width, v4l2.height = scene.intrinsics.height;
-    v4l2.fps = scene.frames.kind == scene::FrameSourceKind::kDevice ? scene.frames.fps : 30.0;
-    if (scene.frames.kind == scene::FrameSourceKind::kDevice) v4l2.settings = scene.frames.controls;
-    if (o.exposure_100us) v4l2.settings.exposure_100us = o.exposure_100us;
-    if (o.gain) v4l2.settings.gain = o.gain;
-    if (o.white_balance_k) v4l2.settings.white_balance_k = o.white_balance_k;
-    v4l2.exposure = scene.exposure;
-    source = capture::OpenV4l2Source(o.device, v4l2);
-    fps = v4l2.fps;
-  } else {
-    if (!scene.frame_times) ThrowInputError("--from: {} has no recorded frames", o.from);
-    source = scene::OpenFrameSource(scene);
-    fps = scene::NominalFps(scene);
-    total = scene.frame_times->frames.size();
-  }
-  if (o.frames) total = total ? std::min(*total, static_cast<size_t>(*o.frames)) : static_cast<size_t>(*o.frames);
-  Log().info("recording {} into {}", source->Describe(), out.string());
-
+  RecordSource source = OpenRecordSource(o, scene);
+  Log().info("recording {} into {}", source.source->Describe(), out.string());
+  // Into out.partial, renamed to `out` once complete with its scene.json.
   const fs::path partial = fs::path(out.string() + ".partial");
   fs::remove_all(partial);
-  capture::RecordingWriter writer(partial, o.images, fps, scene.response);
-  g_stop = false;
-  std::signal(SIGINT, StopRecording);
-  std::signal(SIGTERM, StopRecording);
-  std::optional<Progress> progress;
-  if (total) progress.emplace("record", *total);
-  std::optional<UtcTime> first;
-  const auto start = std::chrono::steady_clock::now();
-  int written = 0;
-  while (!g_stop && (!o.frames || written < *o.frames)) {
-    capture::Frame frame;
-    const capture::FrameStatus status = source->Next(&frame);
-    if (status == capture::FrameStatus::kEnd) break;
-    if (status == capture::FrameStatus::kWaiting) continue;
-    if (status == capture::FrameStatus::kUndecodable) {
-      if (progress) progress->Advance();
-      continue;
-    }
-    if (!first) first = frame.utc;
-    if (o.seconds && frame.utc.SecondsSince(*first) > *o.seconds) break;
-    writer.Write(frame);
-    ++written;
-    if (progress) {
-      progress->Advance();
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      progress->SetSuffix(fmt::format("{:.0f} fps", written / std::max(elapsed, 1e-9)));
-    }
-  }
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
-  progress.reset();
+  capture::RecordingWriter writer(partial, o.images, source.fps, scene.response);
+  const int written = CopyFrames(o, &source, &writer);
   if (written == 0) {
     fs::remove_all(partial);
-    ThrowInputError("record: no frame could be read from {}", source->Describe());
+    ThrowInputError("record: no frame could be read from {}", source.source->Describe());
   }
   writer.Finish();
   WriteFileAtomically(partial / "scene.json", NewSceneJson(scene, writer, partial).dump(2) + "\n");
   fs::remove(out);  // an empty folder, if any
   fs::rename(partial, out);
-  const capture::SourceStats& stats = source->stats();
+  const capture::SourceStats& stats = source.source->stats();
   fmt::print("{} frames written to {}; {} could not be decoded, {} dropped by the driver\n", written, out.string(),
              stats.undecodable, stats.dropped);
   if (stats.undecodable + stats.dropped > 0) {

@@ -46,7 +46,7 @@ void RunRelightEnv(const RelightEnvOptions& o) {
   if (!scene.groundtruth.composites) return;
   const std::filesystem::path truth_file = *scene.groundtruth.composites / "envmaps" / fmt::format("{:06d}.exr", o.frame);
   if (!std::filesystem::is_regular_file(truth_file)) return;
-  const scene::HdrImage truth = scene::ReadHdrImage(truth_file);
+  const HdrImage truth = scene::ReadHdrImage(truth_file);
   if (truth.width != relighter.width() || truth.height != relighter.height()) {
     ThrowInputError("{}: {}x{} does not match the env map's {}x{}", truth_file.string(), truth.width, truth.height,
                     relighter.width(), relighter.height());

@@ -1,11 +1,11 @@
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 #include <algorithm>
 #include <cmath>
 
 #include <glm/gtc/constants.hpp>
 
-namespace daylit::scene {
+namespace daylit {
 namespace {
 
 constexpr double kPi = glm::pi<double>();
@@ -42,4 +42,4 @@ double LatLongTexelSolidAngle(int v, int width, int height) {
   return 2.0 * kPi / width * (std::cos(theta0) - std::cos(theta1));
 }
 
-}  // namespace daylit::scene
+}  // namespace daylit

@@ -6,7 +6,7 @@
 
 #include <glm/glm.hpp>
 
-namespace daylit::scene {
+namespace daylit {
 
 // Unit direction through texel coordinates (u, v); integer u, v give texel centres.
 glm::dvec3 LatLongDirection(double u, double v, int width, int height);
@@ -21,4 +21,4 @@ int LatLongTexel(const glm::dvec3& dir, int width, int height);
 // Solid angle of one texel of row v: (2π/W)·(cos θ0 − cos θ1).
 double LatLongTexelSolidAngle(int v, int width, int height);
 
-}  // namespace daylit::scene
+}  // namespace daylit

@@ -1,4 +1,4 @@
-#include "scene/latlong.h"
+#include "base/latlong.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 
 #include <glm/gtc/constants.hpp>
 
-namespace daylit::scene {
+namespace daylit {
 namespace {
 
 TEST(LatLongTest, ConventionOfTheDesignDoc) {
@@ -34,4 +34,4 @@ TEST(LatLongTest, CoordinatesInvertDirections) {
 }
 
 }  // namespace
-}  // namespace daylit::scene
+}  // namespace daylit
