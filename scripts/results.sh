@@ -4,6 +4,7 @@
 #   - the recording tests, whose figures gtest writes as JSON (tests/courtyard_fixture.h's
 #     RecordFigure),
 #   - daylit estimate and daylit replay of each bundled recording (their figures.json),
+#   - daylit lights on the bundled probes (seed 002's benchmark: errors.csv, automatic.json),
 #   - the machine (cores, CPU, memory, compiler; the GL renderer from the replay).
 # The raw JSON stays in build/results/. Run on an idle machine: about 25 minutes on 2 cores.
 # `daylit results` refuses to write the page if any field of the template was not measured.
@@ -47,6 +48,12 @@ for recording in recordings/*/; do
   "$daylit" -q estimate "$recording" --cache "build/results-cache/$name" --out "$out/$name/estimates.csv" \
     --figures "$out/$name/estimate.json" >/dev/null
   "$daylit" -q replay "$recording" --cache "build/results-cache/$name" --out "$out/$name/replay/replay.mp4" >/dev/null
+done
+
+# Seed 002's benchmark on the five lat-long probes (docs/relight.md).
+for probe in galileo_latlong_1024x512 stpeters_latlong_1024x512 uffizi-large_1024x512 rooitou_park_1k potsdamer_platz_1k; do
+  echo "results: daylit lights on $probe" >&2
+  "$daylit" -q lights "probes/$probe.hdr" --n 1-6,8,16,32,64,128 --threshold 0.05 --out "$out/lights/$probe" >/dev/null
 done
 
 "$daylit" results docs/results.md.in "$out" --out docs/results.md
