@@ -48,15 +48,15 @@ FrameLight FrameEstimator::Estimate(const capture::Frame& frame, const scene::Tr
   out.row = Row(frame, sun);
   const double t_s = SecondsSinceFirst(frame.utc);
   out.sun_moved = sampler_.SetSun(sun.dir_in_scene);
-  const std::vector<Sample> samples = sampler_.Draw(frame.rgb, frame.exposure, frame.linear ? nullptr : &linearizer_);
-  out.fit = FitSunSky(options_.fit, samples);
+  out.samples = sampler_.Draw(frame.rgb, frame.exposure, frame.linear ? nullptr : &linearizer_);
+  out.fit = FitSunSky(options_.fit, out.samples);
   const FilteredLight filtered =
       filter_.Update(t_s, out.fit.IsUsable() ? std::optional<SunSky>(out.fit.light) : std::nullopt, out.fit.confidence);
   if (out.fit.IsUsable()) overcast_share_ = out.fit.overcast_share;
   out.overcast_share = overcast_share_;
   out.row.light = filtered.light;
   out.row.confidence = filtered.confidence;
-  out.row.samples = static_cast<int>(samples.size());
+  out.row.samples = static_cast<int>(out.samples.size());
   return out;
 }
 

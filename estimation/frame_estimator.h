@@ -48,6 +48,7 @@ struct FrameLight {
   double overcast_share = 0.0;
   SunSkyFitSummary fit;     // this frame's own fit (status kTooFewSamples for a held frame)
   bool sun_moved = false;   // the strata and transfer terms were redone for this frame
+  std::vector<Sample> samples;  // what the fit saw (empty for a held frame)
 };
 
 class FrameEstimator {

@@ -120,6 +120,7 @@ std::vector<Sample> Sampler::Draw(const cv::Mat& frame, double exposure, const c
       s.sky = stratum[k].transfer.clear;
       s.overcast = stratum[k].transfer.overcast;
       s.sunlit = sunlit_[i] != 0;
+      s.pixel = i;
       samples.push_back(s);
       ++taken;
     }

@@ -253,6 +253,12 @@ double Confidence(const SunSkyFitOptions& options, const SunSkyFitSummary& summa
 
 }  // namespace
 
+glm::vec3 PredictedRadiance(const Sample& s, const SunSky& light, double overcast_share) {
+  const glm::dvec3 sky = (1.0 - overcast_share) * glm::dvec3(s.sky) + overcast_share * glm::dvec3(s.overcast);
+  return glm::vec3(glm::dvec3(s.albedo) * glm::one_over_pi<double>() *
+                   (glm::dvec3(s.sun) * light.sun_rgb + sky * light.sky_rgb));
+}
+
 SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sample>& samples) {
   SunSkyFitSummary summary;
   std::vector<size_t> usable;

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -31,7 +32,12 @@ struct Sample {
   glm::vec3 sky{0.0f};  // b: irradiance per unit DHI of a clear sky (V with a uniform sky and no interreflection)
   glm::vec3 overcast{0.0f};  // irradiance per unit DHI of a uniform overcast sky
   bool sunlit = false;  // s·max(0, n·l) > 0: the direct sun reaches the point
+  uint32_t pixel = 0;   // the camera pixel (row-major index into the bake's G-buffer)
 };
+
+// What the model predicts for `s` under `light` with the overcast share `overcast_share`:
+// ρ/π · (T_sun·E_sun + ((1 − o)·T_clear + o·T_overcast)·E_sky), radiance units.
+glm::vec3 PredictedRadiance(const Sample& s, const SunSky& light, double overcast_share);
 
 struct SunSkyFitOptions {
   double cauchy_scale = 0.1;        // relative residual at which a sample's weight halves

@@ -202,6 +202,52 @@ cv::Mat LinePlot::Render() const {
   return image;
 }
 
+cv::Mat RenderBarChart(const BarChartOptions& options, const std::vector<BarRow>& rows) {
+  constexpr int kRowHeight = 22, kLabelWidth = 260;
+  const int height = kTop + kBottom + kRowHeight * std::max<int>(1, static_cast<int>(rows.size()));
+  cv::Mat image(height, options.width, CV_8UC3, cv::Scalar(255, 255, 255));
+  double lo = options.origin, hi = options.origin;
+  for (const BarRow& row : rows) {
+    for (const double v : row.values) {
+      if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+  }
+  if (hi == lo) lo -= 0.5, hi += 0.5;
+  const double pad = 0.05 * (hi - lo);
+  lo -= pad, hi += pad;
+  const cv::Rect area(kLabelWidth, kTop, options.width - kLabelWidth - kRight, kRowHeight * std::max<int>(1, static_cast<int>(rows.size())));
+  const auto to_x = [&](double v) { return area.x + static_cast<int>(std::lround((v - lo) / (hi - lo) * area.width)); };
+  const std::vector<double> ticks = NiceTicks(lo, hi, 10);
+  const double step = ticks.size() > 1 ? ticks[1] - ticks[0] : 1.0;
+  for (const double t : ticks) {
+    const int x = to_x(t);
+    cv::line(image, {x, area.y}, {x, area.y + area.height}, kGrid, 1);
+    const std::string label = TickLabel(t, step);
+    int base = 0;
+    const cv::Size size = cv::getTextSize(label, kFont, 0.45, 1, &base);
+    cv::putText(image, label, {x - size.width / 2, area.y + area.height + 18}, kFont, 0.45, kInk, 1, cv::LINE_AA);
+  }
+  for (size_t r = 0; r < rows.size(); ++r) {
+    const int y = area.y + static_cast<int>(r) * kRowHeight;
+    cv::putText(image, rows[r].label, {8, y + kRowHeight - 7}, kFont, 0.42, kInk, 1, cv::LINE_AA);
+    const size_t n = std::max<size_t>(1, rows[r].values.size());
+    const int bar = std::max(2, (kRowHeight - 6) / static_cast<int>(n));
+    for (size_t k = 0; k < rows[r].values.size(); ++k) {
+      const double v = rows[r].values[k];
+      if (!std::isfinite(v)) continue;
+      const std::array<int, 3> rgb = k < options.colors.size() ? options.colors[k] : SeriesColor(static_cast<int>(k));
+      const int top = y + 3 + static_cast<int>(k) * bar;
+      const int a = to_x(options.origin), b = to_x(v);
+      cv::rectangle(image, cv::Rect(std::min(a, b), top, std::max(1, std::abs(b - a)), bar - 1), Bgr(rgb), cv::FILLED);
+    }
+  }
+  cv::line(image, {to_x(options.origin), area.y}, {to_x(options.origin), area.y + area.height}, kInk, 1);
+  cv::rectangle(image, area, kInk, 1);
+  cv::putText(image, options.title, {8, 24}, kFont, 0.6, kInk, 1, cv::LINE_AA);
+  cv::putText(image, options.x_label, {area.x + area.width / 2 - 60, height - 8}, kFont, 0.5, kInk, 1, cv::LINE_AA);
+  return image;
+}
+
 void WritePng(const std::filesystem::path& path, const std::vector<cv::Mat>& panels) {
   cv::Mat stacked;
   cv::vconcat(panels, stacked);

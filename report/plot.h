@@ -43,6 +43,21 @@ class LinePlot {
   std::vector<Series> series_;
 };
 
+// A horizontal bar chart: one row per label, one bar per value in the row (e.g. R, G, B), from
+// `origin` (the reference, drawn as a line) to the value, in the values' colours.
+struct BarRow {
+  std::string label;
+  std::vector<double> values;  // NaN: no bar
+};
+struct BarChartOptions {
+  std::string title;
+  std::string x_label;
+  double origin = 0.0;
+  std::vector<std::array<int, 3>> colors;  // per value in a row
+  int width = 1200;                        // pixels; the height follows the rows
+};
+cv::Mat RenderBarChart(const BarChartOptions& options, const std::vector<BarRow>& rows);
+
 // Stacks images (same width) top to bottom and writes them as one PNG, atomically.
 void WritePng(const std::filesystem::path& path, const std::vector<cv::Mat>& panels);
 

@@ -1,5 +1,5 @@
-// The bundled courtyard-a recording and its bake, as the recording tests use them: loaded once
-// per test binary, the bake from one cache in the build tree that the tests share.
+// The bundled recordings and their bakes, as the recording tests use them: loaded once per test
+// binary, each bake from one cache in the build tree that the tests share.
 #pragma once
 
 #include <string>
@@ -18,14 +18,23 @@ struct BundledCourtyard {
   bake::SceneBake bake;
 };
 
+// A bundled recording (recordings/<name>) and its bake, from the build tree's test cache.
+inline BundledCourtyard LoadBundled(const std::string& name) {
+  SetLogVerbosity(0);
+  BundledCourtyard c{scene::LoadScene(std::string(DAYLIT_SOURCE_DIR "/recordings/") + name), {}};
+  bool loaded = false;
+  c.bake = bake::BakeOrLoad(c.scene, bake::BakeOptions{}, std::string(DAYLIT_BINARY_DIR "/test-cache/") + name, &loaded);
+  return c;
+}
+
 inline const BundledCourtyard& Courtyard() {
-  static const BundledCourtyard courtyard = [] {
-    SetLogVerbosity(0);
-    BundledCourtyard c{scene::LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a"), {}};
-    bool loaded = false;
-    c.bake = bake::BakeOrLoad(c.scene, bake::BakeOptions{}, DAYLIT_BINARY_DIR "/test-cache/courtyard-a", &loaded);
-    return c;
-  }();
+  static const BundledCourtyard courtyard = LoadBundled("courtyard-a");
+  return courtyard;
+}
+
+// courtyard-c: Santiago in June, an arcade lit mostly by reflected light (issue 18).
+inline const BundledCourtyard& CourtyardC() {
+  static const BundledCourtyard courtyard = LoadBundled("courtyard-c");
   return courtyard;
 }
 

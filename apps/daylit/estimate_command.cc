@@ -10,6 +10,7 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "evaluation/lighting_truth.h"
+#include "evaluation/residuals.h"
 #include "evaluation/run_report.h"
 #include "pipeline/lighting_pipeline.h"
 #include "scene/raycaster.h"
@@ -24,11 +25,14 @@ struct EstimateCommandOptions {
   std::string out = "estimates.csv";
   std::string plot;
   std::string figures;
+  std::string residuals;
+  evaluation::ResidualOptions residual;
   pipeline::LightingPipelineOptions pipeline;
 };
 
 void RunEstimateCommand(const EstimateCommandOptions& o) {
   if (const std::string why = o.pipeline.Check(); !why.empty()) ThrowInputError("options: {}", why);
+  if (const std::string why = o.residual.Check(); !why.empty()) ThrowInputError("--residual-{}", why);
   if (!o.figures.empty() && std::filesystem::path(o.figures).extension() != ".json") {
     ThrowInputError("--figures: {} must end in .json", o.figures);
   }
@@ -45,6 +49,8 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   options.stop = interrupt.flag();
   const scene::RayCaster caster(scene.model);
   pipeline::LightingPipeline lighting(scene, baked, caster, options);
+  std::optional<evaluation::ResidualSink> residuals;
+  if (!o.residuals.empty()) lighting.AddSink(&residuals.emplace(scene, baked, o.residual));
   const pipeline::PipelineRun run = lighting.Run(std::move(source));
   const size_t n = run.frames.size();
   double moves_ms = 0.0;
@@ -53,6 +59,7 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   evaluation::RunReport report;
   evaluation::RunFigures(run, &report);
   evaluation::ReportLighting(scene, run.frames, o.out, plot, &report);
+  if (residuals) residuals->Finish(o.residuals, &report);
   if (!o.figures.empty()) report.WriteFigures(o.figures);
   Log().info("{} frames in {:.2f} s ({:.0f} fps end to end); estimation after decoding {:.2f} ms per frame (median), "
              "plus {} sun moves taking {:.0f} ms in all; wrote {} and {}",
@@ -73,6 +80,12 @@ void AddEstimateCommand(CLI::App& app) {
   cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
   cmd->add_option("--out", options->out, "Estimates CSV (default estimates.csv)");
   cmd->add_option("--plot", options->plot, "Plot PNG (default: the CSV's name with .png)");
+  cmd->add_option("--residuals", options->residuals,
+                  "A folder for the self-check that needs no truth: per surface and sunlit/shadowed stratum, observed/"
+                  "predicted radiance (residuals.csv, residuals.png, worst_frame_residuals.png); biased surfaces are "
+                  "named on stderr with their likely cause");
+  cmd->add_option("--residual-threshold", options->residual.threshold,
+                  "A surface is biased when its ratio is further than this from 1 in a channel (default 0.12)");
   cmd->add_option("--figures", options->figures,
                   "Also write the run's figures as JSON (fps, ms per frame, errors against the truth; docs/results.md)");
   cmd->add_option("--samples", options->pipeline.estimator.sampler.samples, "Samples per frame (default 8000)")
