@@ -1,10 +1,12 @@
 #include "evaluation/lighting_truth.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
 
 #include <fmt/format.h>
+#include <glm/gtx/component_wise.hpp>
 
 #include "base/atomic_file.h"
 #include "base/csv.h"
@@ -35,19 +37,30 @@ TruthComparison CompareWithTruth(const std::vector<estimation::FrameEstimate>& f
   }
   TruthComparison cmp;
   std::array<std::vector<double>, 3> sun, sky, ratio;
+  std::vector<double> worst;
   for (const estimation::FrameEstimate& f : frames) {
     const auto it = truth_by_frame.find(f.frame);
     cmp.truth.push_back(it == truth_by_frame.end() ? estimation::SunSky{glm::dvec3(NAN), glm::dvec3(NAN)} : it->second);
+    cmp.worst_channel_error.push_back(NAN);
     if (it == truth_by_frame.end() || !f.decoded) continue;
     ++cmp.frames;
+    double frame_worst = 0.0;
     for (int k = 0; k < 3; ++k) {
       const double ts = it->second.sun_rgb[k], tk = it->second.sky_rgb[k];
       if (tk > 0) sky[static_cast<size_t>(k)].push_back(std::abs(f.light.sky_rgb[k] / tk - 1.0));
       if (ts > 0) sun[static_cast<size_t>(k)].push_back(std::abs(f.light.sun_rgb[k] / ts - 1.0));
+      if (tk > 0) frame_worst = std::max(frame_worst, std::abs(f.light.sky_rgb[k] / tk - 1.0));
+      if (ts > 0) frame_worst = std::max(frame_worst, std::abs(f.light.sun_rgb[k] / ts - 1.0));
       if (ts > 0 && tk > 0 && f.light.sky_rgb[k] > 0) {
         ratio[static_cast<size_t>(k)].push_back(std::abs((f.light.sun_rgb[k] / f.light.sky_rgb[k]) / (ts / tk) - 1.0));
       }
     }
+    cmp.worst_channel_error.back() = frame_worst;
+    worst.push_back(frame_worst);
+  }
+  if (!worst.empty()) {
+    std::sort(worst.begin(), worst.end());
+    cmp.p90_worst_channel_error = worst[std::min(worst.size() - 1, static_cast<size_t>(0.9 * static_cast<double>(worst.size())))];
   }
   for (int k = 0; k < 3; ++k) {
     cmp.sun_error[k] = Median(sun[static_cast<size_t>(k)]);
@@ -55,6 +68,71 @@ TruthComparison CompareWithTruth(const std::vector<estimation::FrameEstimate>& f
     cmp.ratio_error[k] = Median(ratio[static_cast<size_t>(k)]);
   }
   return cmp;
+}
+
+std::vector<Burst> SplitBursts(const std::vector<estimation::FrameEstimate>& frames, double gap_s) {
+  std::vector<Burst> bursts;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    if (i == 0 || !(frames[i].time_utc.SecondsSince(frames[i - 1].time_utc) < gap_s)) {
+      bursts.push_back({static_cast<int>(bursts.size()), i, i});
+    }
+    bursts.back().end = i + 1;
+  }
+  return bursts;
+}
+
+std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEstimate>& frames, const TruthComparison* truth) {
+  std::vector<BurstLighting> out;
+  for (const Burst& b : SplitBursts(frames)) {
+    BurstLighting r;
+    r.burst = b;
+    r.first_frame = frames[b.begin].frame, r.last_frame = frames[b.end - 1].frame;
+    r.sun_elevation_deg = frames[b.begin].sun_elevation_deg;
+    std::array<std::vector<double>, 3> sun, sky, sun_error, sky_error;
+    std::vector<double> confidence;
+    r.min_confidence = 1.0;
+    for (size_t i = b.begin; i < b.end; ++i) {
+      const estimation::FrameEstimate& f = frames[i];
+      if (!f.decoded) continue;
+      confidence.push_back(f.confidence);
+      r.min_confidence = std::min(r.min_confidence, f.confidence);
+      for (size_t k = 0; k < 3; ++k) {
+        sun[k].push_back(f.light.sun_rgb[static_cast<int>(k)]), sky[k].push_back(f.light.sky_rgb[static_cast<int>(k)]);
+        if (truth == nullptr) continue;
+        const estimation::SunSky& t = truth->truth[i];
+        const int c = static_cast<int>(k);
+        if (t.sun_rgb[c] > 0) sun_error[k].push_back(std::abs(f.light.sun_rgb[c] / t.sun_rgb[c] - 1.0));
+        if (t.sky_rgb[c] > 0) sky_error[k].push_back(std::abs(f.light.sky_rgb[c] / t.sky_rgb[c] - 1.0));
+      }
+    }
+    r.confidence = Median(confidence);
+    r.has_truth = truth != nullptr;
+    for (int c = 0; c < 3; ++c) {
+      const size_t k = static_cast<size_t>(c);
+      r.sun[c] = Median(sun[k]), r.sky[c] = Median(sky[k]);
+      if (r.has_truth) r.sun_error[c] = Median(sun_error[k]), r.sky_error[c] = Median(sky_error[k]);
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+
+std::string BurstsCsv(const std::vector<BurstLighting>& bursts) {
+  const bool truth = !bursts.empty() && bursts[0].has_truth;
+  std::string csv = "burst,first_frame,last_frame,frames,sun_elevation_deg,sun_r,sun_g,sun_b,sky_r,sky_g,sky_b,confidence,"
+                    "min_confidence";
+  csv += truth ? ",sun_error_r,sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b\n" : "\n";
+  for (const BurstLighting& b : bursts) {
+    csv += fmt::format("{},{},{},{},{:.3f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{:.4f}", b.burst.index,
+                       b.first_frame, b.last_frame, b.burst.end - b.burst.begin, b.sun_elevation_deg, b.sun.x, b.sun.y,
+                       b.sun.z, b.sky.x, b.sky.y, b.sky.z, b.confidence, b.min_confidence);
+    if (truth) {
+      csv += fmt::format(",{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f}", b.sun_error.x, b.sun_error.y, b.sun_error.z,
+                         b.sky_error.x, b.sky_error.y, b.sky_error.z);
+    }
+    csv += "\n";
+  }
+  return csv;
 }
 
 void PlotEstimates(const std::vector<estimation::FrameEstimate>& frames, const TruthComparison* truth, const std::string& title,
@@ -79,18 +157,72 @@ void PlotEstimates(const std::vector<estimation::FrameEstimate>& frames, const T
       plot.Add(std::move(est));
       if (truth != nullptr) plot.Add(std::move(tru));
     }
+    // Each burst's start as a grey dashed line from 0 to the top of the data.
+    double top = 0.0;
+    for (size_t i = 0; i < frames.size(); ++i) {
+      const estimation::SunSky& l = frames[i].light;
+      top = std::max(top, std::max(glm::compMax(sun ? l.sun_rgb : l.sky_rgb), 0.0));
+      if (truth != nullptr && std::isfinite(truth->truth[i].sun_rgb.x)) {
+        top = std::max(top, glm::compMax(sun ? truth->truth[i].sun_rgb : truth->truth[i].sky_rgb));
+      }
+    }
+    report::Series starts{"burst starts", {}, {}, {150, 150, 150}, true, false};
+    for (const Burst& b : SplitBursts(frames)) {
+      if (b.begin == 0) continue;
+      const double x = frames[b.begin].frame;
+      starts.x.insert(starts.x.end(), {x, x, x}), starts.y.insert(starts.y.end(), {0.0, top, NAN});
+    }
+    if (!starts.x.empty()) plot.Add(std::move(starts));
     panels.push_back(plot.Render());
   }
   report::WritePng(png, panels);
 }
+
+namespace {
+
+std::filesystem::path BurstsCsvPath(const std::filesystem::path& csv) {
+  if (csv.filename() == "estimates.csv") return csv.parent_path() / "bursts.csv";
+  return csv.parent_path() / (csv.stem().string() + "_bursts.csv");
+}
+
+// The per-burst table as report lines and figures (lighting/burst/<k>/...), and bursts.csv.
+void ReportBursts(const std::vector<BurstLighting>& bursts, const std::filesystem::path& csv, RunReport* report) {
+  WriteFileAtomically(csv, BurstsCsv(bursts));
+  const bool truth = !bursts.empty() && bursts[0].has_truth;
+  report->Say(fmt::format("per burst (frames less than {:g} s apart){}:", kBurstGapS,
+                          truth ? ", median relative error (R, G, B)" : ", median estimate (R, G, B)"));
+  report->Say(fmt::format("  {:>5} {:>9} {:>6}  {:<22}{:<22}{}", "burst", "frames", "sun", "E_sun", "E_sky",
+                          "confidence (median, lowest)"));
+  for (const BurstLighting& b : bursts) {
+    const auto three = [&](const glm::dvec3& v) {
+      return truth ? fmt::format("{:5.1f}% {:5.1f}% {:5.1f}%", 100 * v.x, 100 * v.y, 100 * v.z)
+                   : fmt::format("{:6.4g} {:6.4g} {:6.4g}", v.x, v.y, v.z);
+    };
+    report->Say(fmt::format("  {:>5} {:>9} {:5.1f}°  {:<22}{:<22}{:.2f}, {:.2f}", b.burst.index,
+                            fmt::format("{}-{}", b.first_frame, b.last_frame), b.sun_elevation_deg,
+                            three(truth ? b.sun_error : b.sun), three(truth ? b.sky_error : b.sky), b.confidence,
+                            b.min_confidence));
+    const std::string key = fmt::format("lighting/burst/{}/", b.burst.index);
+    report->Figure(key + "confidence", b.confidence);
+    report->Figure(key + "sun_elevation_deg", b.sun_elevation_deg);
+    for (int c = 0; truth && c < 3; ++c) {
+      report->Figure(key + "sun_error/" + std::string(1, "rgb"[c]), b.sun_error[c]);
+      report->Figure(key + "sky_error/" + std::string(1, "rgb"[c]), b.sky_error[c]);
+    }
+  }
+  report->Figure("lighting/bursts", static_cast<double>(bursts.size()));
+}
+
+}  // namespace
 
 std::optional<TruthComparison> ReportLighting(const scene::Scene& scene, const std::vector<estimation::FrameEstimate>& frames,
                                               const std::filesystem::path& csv, const std::filesystem::path& png,
                                               RunReport* report) {
   WriteFileAtomically(csv, estimation::EstimatesCsv(frames));
   std::optional<TruthComparison> truth;
-  if (scene.groundtruth.lighting) {
-    truth = CompareWithTruth(frames, *scene.groundtruth.lighting);
+  if (scene.groundtruth.lighting) truth = CompareWithTruth(frames, *scene.groundtruth.lighting);
+  ReportBursts(CompareBursts(frames, truth ? &*truth : nullptr), BurstsCsvPath(csv), report);
+  if (truth) {
     const auto line = [&](const char* what, const glm::dvec3& e) {
       report->Say(fmt::format("  {:<9}{:5.1f}% {:5.1f}% {:5.1f}%", what, 100 * e.x, 100 * e.y, 100 * e.z));
     };
@@ -98,7 +230,10 @@ std::optional<TruthComparison> ReportLighting(const scene::Scene& scene, const s
     line("E_sun", truth->sun_error);
     line("E_sky", truth->sky_error);
     line("sun/sky", truth->ratio_error);
+    report->Say(fmt::format("  90th percentile over frames of the worst channel's error (E_sun and E_sky): {:.1f}%",
+                            100 * truth->p90_worst_channel_error));
     report->Figure("lighting/frames", truth->frames);
+    report->Figure("lighting/p90_worst_channel_error", truth->p90_worst_channel_error);
     for (int c = 0; c < 3; ++c) {
       const std::string channel(1, "rgb"[c]);
       report->Figure("lighting/sun_error/" + channel, truth->sun_error[c]);

@@ -22,16 +22,48 @@ struct TruthComparison {
   glm::dvec3 sun_error{0.0}, sky_error{0.0}, ratio_error{0.0};
   int frames = 0;
   std::vector<estimation::SunSky> truth;  // per frame, aligned with the estimates
+  // Per frame, aligned: the largest |estimate/truth − 1| over E_sun's and E_sky's channels (E_sun
+  // where its truth is > 0); NaN without truth. Its 90th percentile over the frames with truth.
+  std::vector<double> worst_channel_error;
+  double p90_worst_channel_error = NAN;
 };
 TruthComparison CompareWithTruth(const std::vector<estimation::FrameEstimate>& frames,
                                  const std::filesystem::path& groundtruth_csv);
+
+// A burst: consecutive frames less than `gap_s` apart (a time-lapse's bursts are hours apart).
+// [begin, end) are positions in the run's frames.
+struct Burst {
+  int index = 0;
+  size_t begin = 0, end = 0;
+};
+constexpr double kBurstGapS = 2.0;
+std::vector<Burst> SplitBursts(const std::vector<estimation::FrameEstimate>& frames, double gap_s = kBurstGapS);
+
+// One burst's estimates and, with truth, their errors: medians over its frames of
+// |estimate/truth − 1| per channel (E_sun over frames whose true E_sun is > 0).
+struct BurstLighting {
+  Burst burst;
+  int first_frame = 0, last_frame = 0;
+  double sun_elevation_deg = 0.0;  // at its first frame
+  glm::dvec3 sun{0.0}, sky{0.0};   // median estimates
+  double confidence = 0.0;         // median
+  double min_confidence = 0.0;
+  bool has_truth = false;
+  glm::dvec3 sun_error{NAN}, sky_error{NAN};
+};
+std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEstimate>& frames, const TruthComparison* truth);
+// bursts.csv: burst,first_frame,last_frame,frames,sun_elevation_deg,sun_r,sun_g,sun_b,sky_r,sky_g,
+// sky_b,confidence,min_confidence[,sun_error_r,...,sky_error_b with truth].
+std::string BurstsCsv(const std::vector<BurstLighting>& bursts);
 
 // Estimate vs truth over time, per channel: a PNG with a sun panel and a sky panel.
 void PlotEstimates(const std::vector<estimation::FrameEstimate>& frames, const TruthComparison* truth,
                    const std::string& title, const std::filesystem::path& png);
 
-// The estimates of a run as estimates.csv (`csv`) and their plot (`png`); with the scene's ground
-// truth, the median errors as the report's lines. Returns the comparison, if there was truth.
+// The estimates of a run as estimates.csv (`csv`), the bursts' table beside it (<csv>_bursts.csv,
+// bursts.csv beside a CSV named estimates.csv) and their plot (`png`, the bursts marked); the
+// per-burst table and, with the scene's ground truth, the median errors and the 90th percentile
+// as the report's lines and figures. Returns the comparison, if there was truth.
 std::optional<TruthComparison> ReportLighting(const scene::Scene& scene, const std::vector<estimation::FrameEstimate>& frames,
                                               const std::filesystem::path& csv, const std::filesystem::path& png,
                                               RunReport* report);

@@ -8,8 +8,9 @@
 #             albedo.csv, PNG previews); re-used while the recording is unchanged
 #   replay.mp4  the augmented video: every frame with the scene's virtual objects, lit by that
 #             frame's estimate and shadowed both ways (daylit replay)
-#   estimates.csv, lighting.png
-#             the sun and sky per frame and their plot
+#   estimates.csv, bursts.csv, lighting.png
+#             the sun and sky per frame, per burst (frames less than 2 s apart), and their plot
+#   figures.json  the report's figures under stable keys (scripts/results.sh reads them)
 #   report.txt  speed, and with ground truth the lighting's errors and the composite's fidelity
 #   fidelity.csv, fidelity.png, worst_vs_truth.png
 #             with ground truth: per truth frame, the composite against the path tracer's

@@ -170,6 +170,7 @@ TEST(CliTest, EstimateWritesTheStableCsv) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   std::ifstream figures_in(figures);
   EXPECT_EQ(nlohmann::json::parse(figures_in).at("frames").get<int>(), 1);
+  EXPECT_EQ(ReadCsvFile(rec.dir / "est_bursts.csv").rows.size(), 1u);  // the per-burst table, no truth
   const CsvTable table = ReadCsvFile(out);
   EXPECT_EQ(table.header, (std::vector<std::string>{"frame", "time_utc", "sun_elevation_deg", "sun_azimuth_deg", "sun_r",
                                                      "sun_g", "sun_b", "sky_r", "sky_g", "sky_b", "confidence", "samples"}));
@@ -423,13 +424,19 @@ TEST(CliTest, ReplayWritesTheAugmentedVideoAndItsReport) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("60 frames in"), std::string::npos) << run.out;
   EXPECT_NE(run.err.find("replay 100%"), std::string::npos) << "progress";
-  for (const char* name : {"r.mp4", "estimates.csv", "lighting.png", "report.txt", "figures.json", "fidelity.csv",
-                           "fidelity.png", "worst_vs_truth.png"}) {
+  for (const char* name : {"r.mp4", "estimates.csv", "bursts.csv", "lighting.png", "report.txt", "figures.json",
+                           "fidelity.csv", "fidelity.png", "worst_vs_truth.png"}) {
     EXPECT_TRUE(fs::is_regular_file(dir / name)) << name;
   }
   size_t files = 0;
   for (const auto& entry : fs::directory_iterator(dir)) files += entry.is_regular_file() ? 1 : 0;
-  EXPECT_EQ(files, 8u) << "a temporary file was left behind";
+  EXPECT_EQ(files, 9u) << "a temporary file was left behind";
+  // The first 60 frames are one burst (frames 0.1 s apart), with its errors against the truth.
+  const CsvTable bursts = ReadCsvFile(dir / "bursts.csv");
+  ASSERT_EQ(bursts.rows.size(), 1u);
+  EXPECT_EQ(bursts.rows[0][static_cast<size_t>(bursts.RequireColumn("frames"))], "60");
+  EXPECT_LT(std::stod(bursts.rows[0][static_cast<size_t>(bursts.RequireColumn("sky_error_g"))]), 0.10);
+  EXPECT_NE(run.out.find("per burst"), std::string::npos) << run.out;
   // The report's figures for scripts (docs/results.md): the run and the composite's truth frames.
   std::ifstream figures_in(dir / "figures.json");
   const nlohmann::json figures = nlohmann::json::parse(figures_in);

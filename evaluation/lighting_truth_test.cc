@@ -1,0 +1,68 @@
+#include "evaluation/lighting_truth.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "base/utc_time.h"
+
+namespace daylit::evaluation {
+namespace {
+
+estimation::FrameEstimate Frame(int index, double seconds, double sun_r, double sky_r) {
+  estimation::FrameEstimate f;
+  f.frame = index;
+  f.time_utc = UtcFromUnixSeconds(1.8e9 + seconds);
+  f.light.sun_rgb = glm::dvec3(sun_r, 10.0, 10.0);
+  f.light.sky_rgb = glm::dvec3(sky_r, 2.0, 2.0);
+  f.confidence = 0.5 + 0.01 * index;
+  return f;
+}
+
+// Two bursts of three frames 0.1 s apart, an hour between them, and a frame 2 s after the last:
+// a third burst (less than 2 s apart is the same burst).
+std::vector<estimation::FrameEstimate> Frames() {
+  return {Frame(0, 0.0, 10, 2), Frame(1, 0.1, 11, 2), Frame(2, 0.2, 12, 2),
+          Frame(3, 3600.0, 10, 1), Frame(4, 3600.1, 10, 3), Frame(5, 3601.9, 10, 2), Frame(6, 3603.9, 10, 2)};
+}
+
+TEST(LightingTruthTest, BurstsAreFramesLessThanTwoSecondsApart) {
+  const std::vector<Burst> bursts = SplitBursts(Frames());
+  ASSERT_EQ(bursts.size(), 3u);
+  EXPECT_EQ(bursts[0].begin, 0u);
+  EXPECT_EQ(bursts[0].end, 3u);
+  EXPECT_EQ(bursts[1].begin, 3u);
+  EXPECT_EQ(bursts[1].end, 6u);  // 1.8 s after the one before: the same burst
+  EXPECT_EQ(bursts[2].begin, 6u);  // 2.0 s after: a new one
+  EXPECT_TRUE(SplitBursts({}).empty());
+}
+
+TEST(LightingTruthTest, EachBurstHasItsOwnMedianErrors) {
+  const std::vector<estimation::FrameEstimate> frames = Frames();
+  TruthComparison truth;
+  for (size_t i = 0; i < frames.size(); ++i) truth.truth.push_back({glm::dvec3(10.0), glm::dvec3(2.0)});
+  truth.truth[1].sun_rgb = glm::dvec3(0.0);  // no sun there: left out of E_sun's errors
+  const std::vector<BurstLighting> bursts = CompareBursts(frames, &truth);
+  ASSERT_EQ(bursts.size(), 3u);
+  // Burst 0: E_sun errors 0 and 20% (frame 1 has no true sun, and its 10% is left out): of two,
+  // the median is the upper one (base/statistics.h); E_sky exact.
+  EXPECT_NEAR(bursts[0].sun_error.x, 0.20, 1e-12);
+  EXPECT_NEAR(bursts[0].sky_error.x, 0.0, 1e-12);
+  // Burst 1: E_sky errors 50%, 50%, 0: median 50%, while the whole run's median is 0.
+  EXPECT_NEAR(bursts[1].sky_error.x, 0.5, 1e-12);
+  EXPECT_NEAR(bursts[1].sun_error.x, 0.0, 1e-12);
+  EXPECT_EQ(bursts[1].first_frame, 3);
+  EXPECT_EQ(bursts[1].last_frame, 5);
+  EXPECT_NEAR(bursts[1].confidence, 0.54, 1e-12);
+  EXPECT_NEAR(bursts[1].min_confidence, 0.53, 1e-12);
+  const std::string csv = BurstsCsv(bursts);
+  EXPECT_EQ(csv.substr(0, csv.find('\n')),
+            "burst,first_frame,last_frame,frames,sun_elevation_deg,sun_r,sun_g,sun_b,sky_r,sky_g,sky_b,confidence,"
+            "min_confidence,sun_error_r,sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b");
+  // Without truth: the estimates only.
+  EXPECT_FALSE(CompareBursts(frames, nullptr)[0].has_truth);
+  EXPECT_TRUE(std::isnan(CompareBursts(frames, nullptr)[0].sun_error.x));
+}
+
+}  // namespace
+}  // namespace daylit::evaluation
