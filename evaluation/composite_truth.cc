@@ -34,23 +34,28 @@ std::optional<TruthFrame> ReadTruthFrame(const scene::Scene& scene, int index) {
   return truth;
 }
 
+// A pixel is in the objects' shadow when they change it by more than this (either image).
+constexpr double kShadowChange = 0.02;
+
 CompositeFidelity CompareComposite(const std::vector<float>& composite, const std::vector<float>& frame,
                                    const std::vector<float>& truth_with, const std::vector<float>& truth_without,
                                    const cv::Mat& mask) {
   CompositeFidelity f;
   const size_t pixels = truth_with.size() / 3;
   for (size_t p = 0; p < pixels; ++p) {
-    double error = 0.0, change = 0.0, frame_error = 0.0;
+    double error = 0.0, change = 0.0, drawn = 0.0, frame_error = 0.0;
     for (size_t k = 0; k < 3; ++k) {
       const double t = truth_with[3 * p + k], w = truth_without[3 * p + k];
       error += std::abs(composite[3 * p + k] - t) / std::max(t, 1e-6) / 3.0;
       frame_error += std::abs(frame[3 * p + k] - w) / std::max(w, 1e-6) / 3.0;
       change = std::max(change, std::abs(t / std::max(w, 1e-6) - 1.0));
+      drawn = std::max(drawn, std::abs(composite[3 * p + k] / std::max(frame[3 * p + k], 1e-6f) - 1.0));
     }
     if (mask.data[p] >= 128) {
       f.object_error += error, ++f.object_pixels;
-    } else if (mask.data[p] == 0 && change > 0.02) {
+    } else if (mask.data[p] == 0 && (change > kShadowChange || drawn > kShadowChange)) {
       f.shadow_error += error, f.frame_shadow_error += frame_error, ++f.shadow_pixels;
+      f.false_shadow_pixels += change > kShadowChange ? 0 : 1;
     }
   }
   if (f.object_pixels > 0) f.object_error /= static_cast<double>(f.object_pixels);

@@ -1,8 +1,10 @@
 // Composites against a path tracer's frame with the objects physically present
-// (groundtruth/with_objects), in the measure: the mean relative error of linear radiance
-// over the objects' pixels (mask ≥ 128) and over the pixels of their shadows (no object, mask 0,
-// where the truth with objects differs from the truth without by more than 2%), averaged over
-// RGB. And a strip for a person to look at: truth | daylit | difference.
+// (groundtruth/with_objects): the mean relative error of linear radiance, averaged over RGB, over
+// the objects' pixels (mask ≥ 128) and over the pixels of their shadows. Those are the union of
+// both shadow masks, off the objects (mask 0): where the truth with objects differs from the truth
+// without by more than 2%, or daylit's composite from the frame it was drawn into, so that a
+// shadow drawn where the truth has none counts as much as one missed. And a strip for a person to
+// look at: truth | daylit | difference.
 #pragma once
 
 #include <filesystem>
@@ -31,7 +33,8 @@ struct CompositeFidelity {
   double object_error = 0.0;
   size_t object_pixels = 0;
   double shadow_error = 0.0;
-  size_t shadow_pixels = 0;
+  size_t shadow_pixels = 0;        // the union of both shadow masks
+  size_t false_shadow_pixels = 0;  // of them, where only daylit drew a shadow
   double frame_shadow_error = 0.0;  // the frame itself (before compositing) against the truth
                                     // without objects, on the same pixels: the camera's own share
 };

@@ -56,11 +56,11 @@ void FidelitySink::Finish(const std::filesystem::path& dir, RunReport* report) c
 }
 
 std::string FidelityCsv(const std::vector<FrameFidelity>& rows) {
-  std::string csv = "frame,object_error,object_pixels,shadow_error,shadow_pixels,frame_shadow_error\n";
+  std::string csv = "frame,object_error,object_pixels,shadow_error,shadow_pixels,frame_shadow_error,false_shadow_pixels\n";
   for (const FrameFidelity& r : rows) {
     const CompositeFidelity& f = r.fidelity;
-    csv += fmt::format("{},{:.5f},{},{:.5f},{},{:.5f}\n", r.frame, f.object_error, f.object_pixels, f.shadow_error,
-                       f.shadow_pixels, f.frame_shadow_error);
+    csv += fmt::format("{},{:.5f},{},{:.5f},{},{:.5f},{}\n", r.frame, f.object_error, f.object_pixels, f.shadow_error,
+                       f.shadow_pixels, f.frame_shadow_error, f.false_shadow_pixels);
   }
   return csv;
 }

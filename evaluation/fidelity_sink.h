@@ -38,7 +38,7 @@ class FidelitySink final : public pipeline::FrameSink {
   std::vector<float> worst_truth_, worst_composite_;
 };
 
-// frame,object_error,object_pixels,shadow_error,shadow_pixels,frame_shadow_error
+// frame,object_error,object_pixels,shadow_error,shadow_pixels,frame_shadow_error,false_shadow_pixels
 std::string FidelityCsv(const std::vector<FrameFidelity>& rows);
 void PlotFidelity(const std::vector<FrameFidelity>& rows, const std::string& title, const std::filesystem::path& png);
 
