@@ -46,7 +46,7 @@ for recording in recordings/*/; do
   echo "results: daylit estimate and replay of $name" >&2
   mkdir -p "$out/$name/replay"
   "$daylit" -q estimate "$recording" --cache "build/results-cache/$name" --out "$out/$name/estimates.csv" \
-    --figures "$out/$name/estimate.json" >/dev/null
+    --figures "$out/$name/estimate.json" --residuals "$out/$name/residuals" >/dev/null
   "$daylit" -q replay "$recording" --cache "build/results-cache/$name" --out "$out/$name/replay/replay.mp4" >/dev/null
 done
 
