@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iterator>
 #include <map>
 
 #include <fmt/format.h>
@@ -37,7 +38,6 @@ TruthComparison CompareWithTruth(const std::vector<estimation::FrameEstimate>& f
   }
   TruthComparison cmp;
   std::array<std::vector<double>, 3> sun, sky, ratio;
-  std::vector<double> worst;
   for (const estimation::FrameEstimate& f : frames) {
     const auto it = truth_by_frame.find(f.frame);
     cmp.truth.push_back(it == truth_by_frame.end() ? estimation::SunSky{glm::dvec3(NAN), glm::dvec3(NAN)} : it->second);
@@ -56,8 +56,10 @@ TruthComparison CompareWithTruth(const std::vector<estimation::FrameEstimate>& f
       }
     }
     cmp.worst_channel_error.back() = frame_worst;
-    worst.push_back(frame_worst);
   }
+  std::vector<double> worst;
+  std::copy_if(cmp.worst_channel_error.begin(), cmp.worst_channel_error.end(), std::back_inserter(worst),
+               [](double e) { return !std::isnan(e); });
   if (!worst.empty()) {
     std::sort(worst.begin(), worst.end());
     cmp.p90_worst_channel_error = worst[std::min(worst.size() - 1, static_cast<size_t>(0.9 * static_cast<double>(worst.size())))];

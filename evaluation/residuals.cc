@@ -49,16 +49,13 @@ void ResidualSink::Consume(const pipeline::PipelineFrame& frame) {
   if (!light.fit.IsUsable() || light.samples.empty()) return;
   std::vector<glm::dvec3> observed(strata_.size(), glm::dvec3(0.0)), predicted(strata_.size(), glm::dvec3(0.0));
   std::vector<size_t> count(strata_.size(), 0);
-  std::vector<double> ratios(light.samples.size());
-  for (size_t k = 0; k < light.samples.size(); ++k) {
-    const estimation::Sample& s = light.samples[k];
+  for (const estimation::Sample& s : light.samples) {
     const uint32_t surface = bake_.camera.surface[s.pixel];
-    const glm::dvec3 p(estimation::PredictedRadiance(s, light.fit.light, light.fit.overcast_share));
-    const glm::dvec3 o(s.radiance);
-    ratios[k] = (o.x + o.y + o.z) / std::max(p.x + p.y + p.z, 1e-12);
     if (surface == bake::kNoSurface || 2 * static_cast<size_t>(surface) + 1 >= strata_.size()) continue;
     const size_t key = 2 * static_cast<size_t>(surface) + (s.sunlit ? 1 : 0);
-    observed[key] += o, predicted[key] += p, ++count[key];
+    observed[key] += glm::dvec3(s.radiance);
+    predicted[key] += glm::dvec3(estimation::PredictedRadiance(s, light.fit.light, light.fit.overcast_share));
+    ++count[key];
   }
   for (size_t key = 0; key < strata_.size(); ++key) {
     if (count[key] < static_cast<size_t>(options_.min_samples_per_frame)) continue;
@@ -74,45 +71,48 @@ void ResidualSink::Consume(const pipeline::PipelineFrame& frame) {
   cv::cvtColor(frame.frame.rgb, grey, cv::COLOR_RGB2GRAY);
   grey.convertTo(grey, CV_8U, 0.6 * 255.0);
   cv::cvtColor(grey, worst_image_, cv::COLOR_GRAY2BGR);
-  const int width = bake_.camera.width;
-  for (size_t k = 0; k < light.samples.size(); ++k) {
-    const int x = static_cast<int>(light.samples[k].pixel % static_cast<uint32_t>(width));
-    const int y = static_cast<int>(light.samples[k].pixel / static_cast<uint32_t>(width));
-    cv::rectangle(worst_image_, cv::Rect(x - 1, y - 1, 3, 3), RatioColor(ratios[k]), cv::FILLED);
+  const uint32_t width = static_cast<uint32_t>(bake_.camera.width);
+  for (const estimation::Sample& s : light.samples) {
+    const glm::dvec3 p(estimation::PredictedRadiance(s, light.fit.light, light.fit.overcast_share));
+    const double ratio = (s.radiance.x + s.radiance.y + s.radiance.z) / std::max(p.x + p.y + p.z, 1e-12);
+    const cv::Rect dot(static_cast<int>(s.pixel % width) - 1, static_cast<int>(s.pixel / width) - 1, 3, 3);
+    cv::rectangle(worst_image_, dot, RatioColor(ratio), cv::FILLED);
   }
+}
+
+std::optional<StratumResidual> ResidualSink::StratumOf(size_t surface, bool sunlit) const {
+  const Accumulated& a = strata_[2 * surface + (sunlit ? 1 : 0)];
+  if (a.ratios.empty()) return std::nullopt;
+  StratumResidual r;
+  r.surface = scene_.model.surface_names[surface];
+  r.sunlit = sunlit;
+  r.frames = static_cast<int>(a.ratios.size());
+  r.samples = a.samples;
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double> channel;
+    for (const glm::dvec3& v : a.ratios) channel.push_back(v[c]);
+    r.ratio[c] = MedianInPlace(channel, 1.0);
+  }
+  r.biased = r.frames >= options_.min_frames && Deviation(r.ratio) > options_.threshold;
+  return r;
 }
 
 std::vector<StratumResidual> ResidualSink::Strata() const {
   std::vector<StratumResidual> out;
   for (size_t surface = 0; 2 * surface < strata_.size(); ++surface) {
     for (const bool sunlit : {true, false}) {
-      const Accumulated& a = strata_[2 * surface + (sunlit ? 1 : 0)];
-      if (a.ratios.empty()) continue;
-      StratumResidual r;
-      r.surface = scene_.model.surface_names[surface];
-      r.sunlit = sunlit;
-      r.frames = static_cast<int>(a.ratios.size());
-      r.samples = a.samples;
-      for (int c = 0; c < 3; ++c) {
-        std::vector<double> channel;
-        for (const glm::dvec3& v : a.ratios) channel.push_back(v[c]);
-        r.ratio[c] = MedianInPlace(channel, 1.0);
-      }
-      r.biased = r.frames >= options_.min_frames && Deviation(r.ratio) > options_.threshold;
-      out.push_back(r);
+      if (const std::optional<StratumResidual> r = StratumOf(surface, sunlit)) out.push_back(*r);
     }
   }
   return out;
 }
 
 std::vector<ResidualFinding> ResidualSink::Findings() const {
-  const std::vector<StratumResidual> strata = Strata();
   std::vector<ResidualFinding> findings;
-  for (size_t i = 0; i < strata.size(); ++i) {
-    const StratumResidual& first = strata[i];
-    const StratumResidual* sunlit = first.sunlit ? &first : nullptr;
-    const StratumResidual* shadowed = first.sunlit ? nullptr : &first;
-    if (first.sunlit && i + 1 < strata.size() && strata[i + 1].surface == first.surface) shadowed = &strata[++i];
+  for (size_t surface = 0; 2 * surface < strata_.size(); ++surface) {
+    const std::optional<StratumResidual> sunlit_stratum = StratumOf(surface, true), shadowed_stratum = StratumOf(surface, false);
+    const StratumResidual* sunlit = sunlit_stratum ? &*sunlit_stratum : nullptr;
+    const StratumResidual* shadowed = shadowed_stratum ? &*shadowed_stratum : nullptr;
     const bool sun_off = sunlit != nullptr && sunlit->biased, shade_off = shadowed != nullptr && shadowed->biased;
     if (!sun_off && !shade_off) continue;
     // Both strata judged and off the same way: the surface reflects more or less than its albedo
@@ -138,8 +138,9 @@ std::vector<ResidualFinding> ResidualSink::Findings() const {
       where += fmt::format("{}shadowed {} over {} frames", where.empty() ? "" : ", ", RatioText(shadowed->ratio),
                            shadowed->frames);
     }
-    findings.push_back({first.surface, cause,
-                        fmt::format("{}: observed/predicted radiance (R/G/B) {}, beyond {:.0f}%: likely {}", first.surface,
+    const std::string& name = scene_.model.surface_names[surface];
+    findings.push_back({name, cause,
+                        fmt::format("{}: observed/predicted radiance (R/G/B) {}, beyond {:.0f}%: likely {}", name,
                                     where, 100.0 * options_.threshold, cause)});
   }
   return findings;

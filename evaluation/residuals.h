@@ -9,6 +9,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -67,11 +68,14 @@ class ResidualSink final : public pipeline::FrameSink {
     std::vector<glm::dvec3> ratios;  // per frame
     size_t samples = 0;
   };
+  // A surface's stratum over the run; nullopt when no frame had enough samples of it.
+  std::optional<StratumResidual> StratumOf(size_t surface, bool sunlit) const;
   const scene::Scene& scene_;
   const bake::SceneBake& bake_;
   ResidualOptions options_;
   std::vector<Accumulated> strata_;  // [surface · 2 + sunlit]
-  // The worst frame so far: its spread, number, image (8-bit grey) and samples' ratios.
+  // The worst frame so far: its residual spread, its number, and its image (8-bit, the samples
+  // drawn on it).
   double worst_spread_ = -1.0;
   int worst_frame_ = -1;
   cv::Mat worst_image_;

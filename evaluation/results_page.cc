@@ -2,13 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <fstream>
 #include <set>
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "base/csv.h"
 #include "base/error.h"
 
 namespace daylit::evaluation {
@@ -21,14 +21,6 @@ double SecondsPer(const std::string& time_unit, const std::string& source) {
   if (time_unit == "ms") return 1e-3;
   if (time_unit == "s") return 1.0;
   ThrowInputError("{}: time_unit \"{}\" is not ns, us, ms or s", source, time_unit);
-}
-
-// A text that is a whole number ("0.043", "-2e-3"), as a number.
-bool ParseNumber(const std::string& text, double* value) {
-  if (text.empty()) return false;
-  char* end = nullptr;
-  *value = std::strtod(text.c_str(), &end);
-  return end == text.c_str() + text.size() && std::isfinite(*value);
 }
 
 // A run's name without what Google Benchmark appends for how it ran ("/iterations:3",
@@ -83,7 +75,7 @@ void AddTestFigures(const nlohmann::json& json, const std::string& source, Measu
       for (const auto& [key, value] : test.items()) {
         if (key.find('/') == std::string::npos || !value.is_string()) continue;
         double number = 0.0;
-        if (ParseNumber(value.get<std::string>(), &number)) {
+        if (TryParseFiniteDouble(value.get<std::string>(), &number)) {
           figures->numbers["test/" + key] = number;
         } else {
           figures->texts["test/" + key] = value.get<std::string>();
@@ -190,12 +182,35 @@ std::string MarkdownTable(const CsvTable& table, const std::string& spec) {
     for (const Column& c : columns) {
       const std::string& cell = row[static_cast<size_t>(c.index)];
       double number = 0.0;
-      markdown += " " + (ParseNumber(cell, &number) ? FormatFigure(number, c.unit) : cell) + " |";
+      markdown += " " + (TryParseFiniteDouble(cell, &number) ? FormatFigure(number, c.unit) : cell) + " |";
     }
     markdown += "\n";
   }
   markdown.pop_back();  // the field's own line ends it
   return markdown;
+}
+
+// One field's text; throws InputError naming the key.
+std::string FieldText(const std::string& key, const std::string& unit, const MeasuredFigures& figures) {
+  if (key.rfind("csv:", 0) == 0) {
+    const auto table = figures.tables.find(key.substr(4));
+    if (table == figures.tables.end()) ThrowInputError("no table {} was measured", key.substr(4));
+    try {
+      return MarkdownTable(table->second, unit);
+    } catch (const InputError& e) {
+      ThrowInputError("{}: {}", key, e.what());
+    }
+  }
+  if (const auto number = figures.numbers.find(key); number != figures.numbers.end()) {
+    try {
+      return FormatFigure(number->second, unit);
+    } catch (const InputError& e) {
+      ThrowInputError("{}: {}", key, e.what());
+    }
+  }
+  const auto text = figures.texts.find(key);
+  if (text != figures.texts.end() && unit.empty()) return text->second;
+  ThrowInputError("nothing measured \"{}\"{}", key, text != figures.texts.end() ? " as a number" : "");
 }
 
 }  // namespace
@@ -215,25 +230,10 @@ std::string FillResultsPage(const std::string& page_template, const std::string&
     const size_t bar = field.find('|');
     const std::string key = field.substr(0, bar);
     const std::string unit = bar == std::string::npos ? "" : field.substr(bar + 1);
-    if (key.rfind("csv:", 0) == 0) {
-      const auto table = figures.tables.find(key.substr(4));
-      if (table == figures.tables.end()) ThrowInputError("{}:{}: no table {} was measured", template_name, line, key.substr(4));
-      try {
-        page += MarkdownTable(table->second, unit);
-      } catch (const InputError& e) {
-        ThrowInputError("{}:{}: {}: {}", template_name, line, key, e.what());
-      }
-    } else if (const auto number = figures.numbers.find(key); number != figures.numbers.end()) {
-      try {
-        page += FormatFigure(number->second, unit);
-      } catch (const InputError& e) {
-        ThrowInputError("{}:{}: {}: {}", template_name, line, key, e.what());
-      }
-    } else if (const auto text = figures.texts.find(key); text != figures.texts.end() && unit.empty()) {
-      page += text->second;
-    } else {
-      ThrowInputError("{}:{}: nothing measured \"{}\"{}", template_name, line, key,
-                      text != figures.texts.end() ? " as a number" : "");
+    try {
+      page += FieldText(key, unit, figures);
+    } catch (const InputError& e) {
+      ThrowInputError("{}:{}: {}", template_name, line, e.what());
     }
     at = close + 2;
   }
