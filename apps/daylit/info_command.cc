@@ -7,6 +7,7 @@
 #include "base/csv.h"
 #include "base/error.h"
 #include "base/log.h"
+#include "evaluation/lighting_truth.h"
 #include "capture/video_probe.h"
 #include "scene/envmap_probe.h"
 #include "scene/scene.h"
@@ -17,8 +18,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Gaps longer than this split a recording into bursts.
-constexpr double kBurstGapS = 60.0;
+// A new burst starts where frames are kBurstGapS or more apart, as the estimate's per-burst
+// table splits them (evaluation/lighting_truth.h).
+using evaluation::kBurstGapS;
 
 std::string Relative(const scene::Scene& scene, const fs::path& path) {
   return path.lexically_relative(scene.folder).string();
@@ -107,14 +109,14 @@ std::vector<std::string> PrintFrames(const scene::Scene& scene) {
     if (missing > 0) problems.push_back(fmt::format("{} frame images missing", missing));
   }
   size_t bursts = 1;
-  for (size_t i = 1; i < n; ++i) bursts += times.frames[i].utc.SecondsSince(times.frames[i - 1].utc) > kBurstGapS;
+  for (size_t i = 1; i < n; ++i) bursts += times.frames[i].utc.SecondsSince(times.frames[i - 1].utc) >= kBurstGapS;
   fmt::print("             {}: {} frames, {} -> {} (span {}), {} burst{}\n", Relative(scene, times.file), n,
              FormatUtcTime(times.frames.front().utc), FormatUtcTime(times.frames.back().utc),
              Duration(times.SpanSeconds()), bursts, bursts == 1 ? "" : "s");
   // The sun path: first frame of each burst, and the last frame.
   fmt::print("sun          frame {:>5}  {}\n", 0, SunLine(scene, times.frames.front().utc));
   for (size_t i = 1; i < n; ++i) {
-    if (times.frames[i].utc.SecondsSince(times.frames[i - 1].utc) > kBurstGapS) {
+    if (times.frames[i].utc.SecondsSince(times.frames[i - 1].utc) >= kBurstGapS) {
       fmt::print("             frame {:>5}  {}\n", i, SunLine(scene, times.frames[i].utc));
     }
   }
