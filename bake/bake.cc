@@ -119,7 +119,7 @@ EnvMapMaps ComputeEnvMapMaps(const scene::Scene& scene, const scene::RayCaster& 
   }
   // Pass 1, coarse: each surface's albedo and typical indirect light, for the points that the
   // capture point cannot see (pass 2 needs their radiance and the map shows what hides them).
-  CaptureScene capture_scene{&caster, env, &sky, &env_distance, &maps.surface, nullptr, capture, *sun};
+  CaptureScene capture_scene{&caster, env, &sky, &env_distance, &maps.surface, &maps.normal, nullptr, capture, *sun};
   RayOptions coarse = options.rays;
   coarse.hemisphere_rays = std::max(16, options.rays.hemisphere_rays / 4);
   {
@@ -127,8 +127,12 @@ EnvMapMaps ComputeEnvMapMaps(const scene::Scene& scene, const scene::RayCaster& 
     IntegrateCaptureIrradiance(capture_scene, coarse, points.data(), normals.data(), points.size(), v.data(), e.data(),
                                direct.data(), &progress);
   }
-  const HiddenSurfaceModel hidden = SurfaceModelFrom(scene.model, maps.radiance, surface_texels, maps.surface, e, direct);
+  HiddenSurfaceModel hidden = SurfaceModelFrom(scene.model, maps.radiance, surface_texels, maps.surface, e, direct);
   capture_scene.hidden = &hidden;
+  {
+    Progress progress("bake: hidden cells ", points.size());
+    GatherHiddenCells(capture_scene, coarse, points.data(), normals.data(), points.size(), &hidden, &progress);
+  }
   {
     Progress progress("bake: env light, 2/2 ", points.size());
     IntegrateCaptureIrradiance(capture_scene, options.rays, points.data(), normals.data(), points.size(), v.data(),

@@ -3,6 +3,7 @@
 #include "base/options_check.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <cmath>
@@ -26,6 +27,13 @@ glm::vec3 DirectSun(const CaptureScene& capture, const glm::vec3& origin, const 
   return sun.dni_rgb * cos_sun;
 }
 
+bool IsHidden(const CaptureScene& capture, const glm::vec3& y, const scene::RayHit& hit) {
+  const glm::vec3 toward = y - capture.capture_position;
+  const size_t texel = static_cast<size_t>(LatLongTexel(glm::dvec3(toward), capture.env->width, capture.env->height));
+  return !CaptureSees(toward, hit.normal, hit.surface, (*capture.env_distance)[texel], (*capture.env_surface)[texel],
+                      (*capture.env_normal)[texel], capture.env->height);
+}
+
 // Radiance of model point y (hit by a ray, with `hit`'s surface and normal) at capture time.
 glm::vec3 RadianceAt(const CaptureScene& capture, const glm::vec3& y, const scene::RayHit& hit) {
   const glm::vec3 toward = y - capture.capture_position;
@@ -33,23 +41,25 @@ glm::vec3 RadianceAt(const CaptureScene& capture, const glm::vec3& y, const scen
   const glm::vec3 texel_radiance = TexelRadiance(*capture.env, texel);
   if (capture.hidden == nullptr || capture.env_distance == nullptr) return texel_radiance;
   if (CaptureSees(toward, hit.normal, hit.surface, (*capture.env_distance)[static_cast<size_t>(texel)],
-                  (*capture.env_surface)[static_cast<size_t>(texel)], capture.env->height)) {
+                  (*capture.env_surface)[static_cast<size_t>(texel)], (*capture.env_normal)[static_cast<size_t>(texel)],
+                  capture.env->height)) {
     return texel_radiance;
   }
-  const glm::vec3 e = capture.hidden->indirect[hit.surface] + DirectSun(capture, y + 2e-3f * hit.normal, hit.normal);
+  const glm::vec3 e = capture.hidden->IndirectAt(y, hit.normal, hit.surface) +
+                      DirectSun(capture, y + 2e-3f * hit.normal, hit.normal);
   return capture.hidden->albedo[hit.surface] * glm::one_over_pi<float>() * e;
 }
 
 }  // namespace
 
 bool CaptureSees(const glm::vec3& toward, const glm::vec3& normal, uint32_t surface, float seen_distance,
-                 uint32_t seen_surface, int env_height) {
+                 uint32_t seen_surface, const glm::vec3& seen_normal, int env_height) {
   // The capture point sees y unless its own ray toward y stops clearly short of it. The texel's
   // ray can be up to a texel off y's direction; on y's own surface seen at a grazing angle that
   // moves its hit along the surface by distance·angle / cos, so the slack grows with obliquity.
   const float distance = glm::length(toward);
   const float texel_angle = 2.0f * glm::pi<float>() / static_cast<float>(env_height);
-  const bool same_surface = seen_surface == surface;
+  const bool same_surface = seen_surface == surface && glm::dot(seen_normal, normal) > 0.9f;
   const float obliquity = std::max(0.05f, std::abs(glm::dot(normal, toward / distance)));
   const float slack = 0.05f + distance * texel_angle * (same_surface ? 2.0f / obliquity : 2.0f);
   return seen_distance >= 0.0f && seen_distance >= distance - slack;
@@ -83,6 +93,76 @@ void IntegrateCaptureIrradiance(const CaptureScene& capture, const RayOptions& o
     }
     if (progress != nullptr) progress->Advance(range.size());
   });
+}
+
+uint64_t HiddenSurfaceModel::CellKey(const glm::vec3& y, const glm::vec3& normal, uint32_t surface) {
+  const glm::ivec3 cell(glm::floor(y / kCellSize));
+  const glm::ivec3 side(glm::round(normal * 8.0f));
+  uint64_t key = surface;
+  for (const int v : {cell.x, cell.y, cell.z}) key = key * 0x100000001b3ull ^ static_cast<uint64_t>(static_cast<uint32_t>(v));
+  for (const int v : {side.x, side.y, side.z}) key = key * 0x100000001b3ull ^ static_cast<uint64_t>(v + 8);
+  return key;
+}
+
+glm::vec3 HiddenSurfaceModel::IndirectAt(const glm::vec3& y, const glm::vec3& normal, uint32_t surface) const {
+  const auto it = cell_indirect.find(CellKey(y, normal, surface));
+  return it != cell_indirect.end() ? it->second : indirect[surface];
+}
+
+void GatherHiddenCells(const CaptureScene& capture, const RayOptions& options, const glm::vec3* points,
+                       const glm::vec3* normals, size_t count, HiddenSurfaceModel* hidden, Progress* progress) {
+  struct Found {
+    uint64_t order;  // point · rays + ray: the first finder wins, whatever the threads did
+    glm::vec3 point, normal;
+    uint32_t surface;
+  };
+  const std::vector<glm::vec3> hemisphere = CosineHemisphere(options.hemisphere_rays);
+  tbb::enumerable_thread_specific<std::unordered_map<uint64_t, Found>> found_by_thread;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kGrain), [&](const tbb::blocked_range<size_t>& range) {
+    std::unordered_map<uint64_t, Found>& found = found_by_thread.local();
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const glm::vec3 origin = points[i] + options.offset_m * normals[i];
+      const glm::mat3 frame = HemisphereFrame(normals[i], static_cast<uint32_t>(i));
+      for (size_t r = 0; r < hemisphere.size(); ++r) {
+        const glm::vec3 dir = frame * hemisphere[r];
+        const scene::RayHit hit = capture.caster->Intersect(origin, dir);
+        if (!hit.IsHit()) continue;
+        const glm::vec3 y = origin + hit.t * dir;
+        if (!IsHidden(capture, y, hit)) continue;
+        const Found f{i * hemisphere.size() + r, y, hit.normal, hit.surface};
+        const auto [it, inserted] = found.emplace(HiddenSurfaceModel::CellKey(y, hit.normal, hit.surface), f);
+        if (!inserted && f.order < it->second.order) it->second = f;
+      }
+    }
+    if (progress != nullptr) progress->Advance(range.size());
+  });
+  std::unordered_map<uint64_t, Found> cells;
+  for (const auto& found : found_by_thread) {
+    for (const auto& [key, f] : found) {
+      const auto [it, inserted] = cells.emplace(key, f);
+      if (!inserted && f.order < it->second.order) it->second = f;
+    }
+  }
+  std::vector<std::pair<uint64_t, Found>> list(cells.begin(), cells.end());
+  std::vector<glm::vec3> indirect(list.size());
+  const float inv_rays = 1.0f / static_cast<float>(hemisphere.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, list.size(), 16), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t k = range.begin(); k != range.end(); ++k) {
+      const Found& f = list[k].second;
+      const float size = HiddenSurfaceModel::kCellSize;
+      const glm::vec3 centre = (glm::floor(f.point / size) + 0.5f) * size;
+      const glm::vec3 origin = centre - glm::dot(centre - f.point, f.normal) * f.normal + options.offset_m * f.normal;
+      const glm::mat3 frame = HemisphereFrame(f.normal, static_cast<uint32_t>(list[k].first));
+      glm::vec3 sum(0.0f);
+      for (const glm::vec3& local : hemisphere) {
+        const glm::vec3 dir = frame * local;
+        const scene::RayHit hit = capture.caster->Intersect(origin, dir);
+        sum += hit.IsHit() ? RadianceAt(capture, origin + hit.t * dir, hit) : Lookup(*capture.sky, dir);
+      }
+      indirect[k] = glm::pi<float>() * inv_rays * sum;
+    }
+  });
+  for (size_t k = 0; k < list.size(); ++k) hidden->cell_indirect[list[k].first] = indirect[k];
 }
 
 void SkyVisibility(const scene::RayCaster& caster, const RayOptions& options, const glm::vec3* points,

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <unordered_map>
 
 #include <cstdint>
 #include <vector>
@@ -25,11 +26,20 @@ struct RayOptions {
 };
 
 // Radiance of model points the capture point cannot see (the env map shows what hides them):
-// L = ρ_s/π · (E_sun·s·max(0, n·l) + E_indirect,s) with the surface's albedo and typical indirect
-// irradiance from a first, coarser pass.
+// L = ρ_s/π · (E_sun·s·max(0, n·l) + E_indirect) with the surface's albedo and the indirect
+// irradiance of the point's cell (25 cm of one side of its surface), gathered by the cell's own
+// rays. Indirect light under an overhang is local: the hidden underside of an arcade's roof gets
+// 40% of what the roof's visible texels get, and a surface median gave it all of it.
 struct HiddenSurfaceModel {
   std::vector<glm::vec3> albedo;    // per surface
   std::vector<glm::vec3> indirect;  // per surface: median E − E_sun over its visible texels
+  std::unordered_map<uint64_t, glm::vec3> cell_indirect;  // CellKey -> E − E_sun at the cell's centre
+
+  static constexpr float kCellSize = 0.25f;  // m
+  // The cell of point y on `surface`, seen from the side its unit `normal` faces.
+  static uint64_t CellKey(const glm::vec3& y, const glm::vec3& normal, uint32_t surface);
+  // The cell's indirect irradiance, or the surface's where the cell was not gathered.
+  glm::vec3 IndirectAt(const glm::vec3& y, const glm::vec3& normal, uint32_t surface) const;
 };
 
 // What the scene looked like at capture time.
@@ -39,16 +49,20 @@ struct CaptureScene {
   const HdrImage* sky = nullptr;  // SkyOnly(env): sky radiance in every direction
   const std::vector<float>* env_distance = nullptr;    // per texel: capture point to its hit (< 0: sky)
   const std::vector<uint32_t>* env_surface = nullptr;  // per texel: the surface it shows
+  const std::vector<glm::vec3>* env_normal = nullptr;  // per texel: that surface's normal (facing the capture)
   const HiddenSurfaceModel* hidden = nullptr;         // null: hidden points take the texel's radiance
   glm::vec3 capture_position{0.0f};
   CaptureSun sun;
 };
 
-// Whether the capture point sees model point y (on `surface`, unit `normal`, at `toward` = y −
-// capture position) in the env texel toward it, whose own ray hits `seen_surface` at
-// `seen_distance` (< 0: sky), in a map `env_height` texels high.
+// Whether the capture point sees model point y (on `surface`, unit `normal` facing the side that
+// is looked at, at `toward` = y − capture position) in the env texel toward it, whose own ray hits
+// `seen_surface` with unit normal `seen_normal` at `seen_distance` (< 0: sky), in a map
+// `env_height` texels high. A texel that shows the same plane from the same side may hit it a
+// little off y (grazing views); another face of the same surface (a slab's front edge in front of
+// its underside) is something else in front of y.
 bool CaptureSees(const glm::vec3& toward, const glm::vec3& normal, uint32_t surface, float seen_distance,
-                 uint32_t seen_surface, int env_height);
+                 uint32_t seen_surface, const glm::vec3& seen_normal, int env_height);
 
 // For each point (unit normal facing its visible side): V = share of cosine-weighted rays that
 // reach the sky, and E = E_sun·s·max(0, n·l) + π·mean(L_in), where L_in is the sky's radiance
@@ -59,6 +73,13 @@ bool CaptureSees(const glm::vec3& toward, const glm::vec3& normal, uint32_t surf
 void IntegrateCaptureIrradiance(const CaptureScene& capture, const RayOptions& options, const glm::vec3* points,
                                 const glm::vec3* normals, size_t count, float* sky_visibility, glm::vec3* irradiance,
                                 glm::vec3* direct, Progress* progress);
+
+// The cells of the hidden points that `options.hemisphere_rays` rays from the points hit, each
+// gathered from its centre (dropped onto the plane of the hit that found it first) like
+// IntegrateCaptureIrradiance gathers a point, hidden points of its own taking their surface's
+// indirect light; into `hidden->cell_indirect`. `capture.hidden` must be `hidden`.
+void GatherHiddenCells(const CaptureScene& capture, const RayOptions& options, const glm::vec3* points,
+                       const glm::vec3* normals, size_t count, HiddenSurfaceModel* hidden, Progress* progress);
 
 // V alone, with occlusion rays (cheaper than IntegrateCaptureIrradiance).
 void SkyVisibility(const scene::RayCaster& caster, const RayOptions& options, const glm::vec3* points,

@@ -19,6 +19,19 @@ namespace daylit::estimation {
 namespace {
 
 constexpr size_t kGrain = 32;  // pixels per task
+constexpr float kDeepCellScale = 4.0f;  // deeper cells are this many times a level-1 cell's edge
+
+// Unit directions as three signed bytes (0.5° at worst): a cell keeps those of its rays that
+// reach the sky.
+uint32_t PackDirection(const glm::vec3& d) {
+  const glm::ivec3 q(glm::round(glm::clamp(d, -1.0f, 1.0f) * 127.0f));
+  return static_cast<uint32_t>(q.x + 128) | (static_cast<uint32_t>(q.y + 128) << 8) | (static_cast<uint32_t>(q.z + 128) << 16);
+}
+glm::vec3 UnpackDirection(uint32_t p) {
+  const glm::vec3 q(static_cast<float>(p & 0xff) - 128.0f, static_cast<float>((p >> 8) & 0xff) - 128.0f,
+                    static_cast<float>((p >> 16) & 0xff) - 128.0f);
+  return glm::normalize(q);
+}
 
 HdrImage ImageOf(const bake::EnvMapMaps& env) {
   HdrImage image{env.width, env.height, std::vector<float>(env.radiance.size() * 3)};
@@ -31,7 +44,7 @@ HdrImage ImageOf(const bake::EnvMapMaps& env) {
 }  // namespace
 
 std::string TransferOptions::Check() const {
-  return FirstProblem({InClosed("rays", rays, 8, 65536), InClosed("hidden_sky_rays", hidden_sky_rays, 8, 65536),
+  return FirstProblem({InClosed("rays", rays, 8, 65536), InClosed("cell_rays", cell_rays, 8, 65536),
                        InOpenClosed("offset_m", offset_m, 0.0f, 0.1f), InClosed("bounces", bounces, 1, 8)});
 }
 
@@ -67,7 +80,7 @@ void LightTransfer::Trace(const std::vector<uint32_t>& pixels) {
   if (fresh.empty()) return;
   std::vector<TracedPixel> traced(fresh.size());
   TraceHemispheres(fresh, &traced);
-  FillHiddenSkyVisibility(&traced);
+  TraceCells(&traced);
   StorePaths(fresh, traced);
 }
 
@@ -80,7 +93,7 @@ LightTransfer::Bounce LightTransfer::BounceAt(const glm::vec3& y, const scene::R
     const glm::vec3 toward = y - capture_position_;
     const size_t texel = static_cast<size_t>(LatLongTexel(glm::dvec3(toward), env.width, env.height));
     const float seen = env.IsSky(texel) ? -1.0f : glm::length(env.point[texel] - capture_position_);
-    if (bake::CaptureSees(toward, hit.normal, hit.surface, seen, env.surface[texel], env.height) &&
+    if (bake::CaptureSees(toward, hit.normal, hit.surface, seen, env.surface[texel], env.normal[texel], env.height) &&
         glm::compMax(env.albedo[texel]) > 0.0f) {
       b.albedo = env.albedo[texel];
       b.sky_visibility = env.sky_visibility[texel];
@@ -123,39 +136,109 @@ void LightTransfer::TraceHemispheres(const std::vector<uint32_t>& fresh, std::ve
   });
 }
 
-// V of the bounce points the capture point does not see (~5% of them on courtyard-a), by ray
-// casting, once per 25 cm cell of a surface side: V is smooth, and tracing each point alone
-// cost more rays than the primary ones.
-void LightTransfer::FillHiddenSkyVisibility(std::vector<TracedPixel>* traced) {
-  std::vector<Bounce*> hidden;
+// The cells of the points' bounce points, and theirs in turn down to the level the bounces need
+// (level L's hits get cells while L < bounces − 1; level 1 is always traced, for V). A cell first
+// met deeper and later by a point keeps its trace and gets its hits' cells then.
+void LightTransfer::TraceCells(std::vector<TracedPixel>* traced) {
+  const uint32_t deepest = static_cast<uint32_t>(std::max(1, options_.bounces - 1));
+  std::vector<uint32_t> level;
   for (TracedPixel& pixel : *traced) {
-    for (Bounce& b : pixel.bounces) {
-      if (b.sky_visibility < 0.0f) hidden.push_back(&b);
+    for (Bounce& b : pixel.bounces) b.cell = CellFor(b, 1);
+  }
+  for (uint32_t depth = 1; depth <= deepest; ++depth) {
+    std::vector<uint32_t> untraced, unexpanded;
+    for (uint32_t c = 0; c < cells_.size(); ++c) {
+      if (cells_[c].level != depth) continue;
+      if (!cells_[c].traced) untraced.push_back(c);
+      if (!cells_[c].expanded && depth < deepest) unexpanded.push_back(c);
+    }
+    TraceNewCells(untraced);
+    for (const uint32_t c : unexpanded) {
+      cells_[c].expanded = true;
+      for (uint32_t i = cells_[c].bounce_begin; i < cells_[c].bounce_end; ++i) {
+        cell_bounces_[i].cell = CellFor(cell_bounces_[i], depth + 1);
+      }
     }
   }
-  std::vector<uint64_t> keys(hidden.size());
-  std::vector<std::pair<uint64_t, Bounce*>> missing;
-  for (size_t i = 0; i < hidden.size(); ++i) {
-    keys[i] = CellOf(*hidden[i]);
-    if (hidden_cells_.emplace(keys[i], -1.0f).second) missing.emplace_back(keys[i], hidden[i]);
+  FillHiddenSkyVisibility(traced);
+}
+
+uint32_t LightTransfer::CellFor(const Bounce& b, uint32_t level) {
+  const auto [it, inserted] = cell_of_.emplace(CellKey(b, std::min(level, 2u)), static_cast<uint32_t>(cells_.size()));
+  if (inserted) {
+    const float size = level == 1 ? kCellSize : kDeepCellScale * kCellSize;
+    const glm::vec3 centre = (glm::floor(b.point / size) + 0.5f) * size;
+    cells_.push_back({centre - glm::dot(centre - b.point, b.normal) * b.normal, b.normal, level});
+  } else if (cells_[it->second].level > level) {
+    cells_[it->second].level = level;
   }
-  const std::vector<glm::vec3> cell_hemisphere = bake::CosineHemisphere(options_.hidden_sky_rays);
-  std::vector<float> cell_v(missing.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, missing.size(), kGrain), [&](const tbb::blocked_range<size_t>& range) {
+  return it->second;
+}
+
+// Each new cell's hemisphere from its origin: V (the share of rays that escape) and its hits.
+void LightTransfer::TraceNewCells(const std::vector<uint32_t>& cells) {
+  const std::vector<glm::vec3> hemisphere = bake::CosineHemisphere(options_.cell_rays);
+  std::vector<std::vector<Bounce>> hits(cells.size());
+  std::vector<std::vector<uint32_t>> open_dirs(cells.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 8), [&](const tbb::blocked_range<size_t>& range) {
+    thread_local std::vector<glm::vec3> dirs;
+    thread_local std::vector<scene::RayHit> ray_hits;
     for (size_t i = range.begin(); i != range.end(); ++i) {
-      // The cell's centre dropped onto the bounce point's plane: the same point for every bounce
-      // in the cell, so the result does not depend on which one came first.
-      const Bounce& b = *missing[i].second;
-      const glm::vec3 centre = (glm::floor(b.point / kCellSize) + 0.5f) * kCellSize;
-      const glm::vec3 origin = centre - glm::dot(centre - b.point, b.normal) * b.normal;
-      const glm::mat3 frame = bake::HemisphereFrame(b.normal, static_cast<uint32_t>(missing[i].first));
+      Cell& cell = cells_[cells[i]];
+      const glm::mat3 frame = bake::HemisphereFrame(cell.normal, cells[i]);
+      dirs.resize(hemisphere.size()), ray_hits.resize(hemisphere.size());
+      for (size_t r = 0; r < dirs.size(); ++r) dirs[r] = frame * hemisphere[r];
+      caster_.IntersectFrom(cell.origin, dirs.data(), dirs.size(), 0.0f, ray_hits.data());
       int open = 0;
-      for (const glm::vec3& d : cell_hemisphere) open += caster_.Occluded(origin, frame * d) ? 0 : 1;
-      cell_v[i] = static_cast<float>(open) / static_cast<float>(cell_hemisphere.size());
+      for (size_t r = 0; r < dirs.size(); ++r) {
+        if (!ray_hits[r].IsHit()) {
+          ++open;
+          open_dirs[i].push_back(PackDirection(dirs[r]));
+        } else if (options_.interreflection) {
+          hits[i].push_back(BounceAt(cell.origin + ray_hits[r].t * dirs[r], ray_hits[r]));
+        }
+      }
+      cell.sky_visibility = static_cast<float>(open) / static_cast<float>(dirs.size());
     }
   });
-  for (size_t i = 0; i < missing.size(); ++i) hidden_cells_[missing[i].first] = cell_v[i];
-  for (size_t i = 0; i < hidden.size(); ++i) hidden[i]->sky_visibility = hidden_cells_[keys[i]];
+  for (size_t i = 0; i < cells.size(); ++i) {
+    Cell& cell = cells_[cells[i]];
+    cell.traced = true;
+    cell.bounce_begin = static_cast<uint32_t>(cell_bounces_.size());
+    for (Bounce b : hits[i]) {
+      b.orientation = OrientationOf(b.normal);
+      cell_bounces_.push_back(b);
+    }
+    cell.bounce_end = static_cast<uint32_t>(cell_bounces_.size());
+    cell.sky_begin = static_cast<uint32_t>(cell_sky_.size());
+    cell_sky_.insert(cell_sky_.end(), open_dirs[i].begin(), open_dirs[i].end());
+    cell.sky_end = static_cast<uint32_t>(cell_sky_.size());
+  }
+}
+
+// V of the bounce points the capture point does not see (~5% of them on courtyard-a): their
+// cell's (V is smooth). Hits of the deepest cells have no cell: the mean V of their surface's cells.
+void LightTransfer::FillHiddenSkyVisibility(std::vector<TracedPixel>* traced) {
+  for (TracedPixel& pixel : *traced) {
+    for (Bounce& b : pixel.bounces) {
+      if (b.sky_visibility < 0.0f) b.sky_visibility = cells_[b.cell].sky_visibility;
+    }
+  }
+  std::unordered_map<uint32_t, std::pair<double, int>> by_surface;
+  for (Bounce& b : cell_bounces_) {
+    if (b.sky_visibility < 0.0f && b.cell != kNoCell && cells_[b.cell].traced) b.sky_visibility = cells_[b.cell].sky_visibility;
+  }
+  for (const Bounce& b : cell_bounces_) {
+    if (b.cell != kNoCell && cells_[b.cell].traced) {
+      auto& [sum, n] = by_surface[b.surface];
+      sum += cells_[b.cell].sky_visibility, ++n;
+    }
+  }
+  for (Bounce& b : cell_bounces_) {
+    if (b.sky_visibility >= 0.0f) continue;
+    const auto it = by_surface.find(b.surface);
+    b.sky_visibility = it == by_surface.end() ? 0.5f : static_cast<float>(it->second.first / it->second.second);
+  }
 }
 
 void LightTransfer::StorePaths(const std::vector<uint32_t>& fresh, const std::vector<TracedPixel>& traced) {
@@ -180,10 +263,11 @@ void LightTransfer::StorePaths(const std::vector<uint32_t>& fresh, const std::ve
   }
 }
 
-uint64_t LightTransfer::CellOf(const Bounce& b) {
-  const glm::ivec3 cell(glm::floor(b.point / kCellSize));
+uint64_t LightTransfer::CellKey(const Bounce& b, uint32_t level) {
+  const float size = level == 1 ? kCellSize : kDeepCellScale * kCellSize;
+  const glm::ivec3 cell(glm::floor(b.point / size));
   const glm::ivec3 side(glm::round(b.normal * 8.0f));
-  uint64_t key = b.surface;
+  uint64_t key = b.surface * 4ull + level;
   for (const int v : {cell.x, cell.y, cell.z}) key = key * 0x100000001b3ull ^ static_cast<uint64_t>(static_cast<uint32_t>(v));
   for (const int v : {side.x, side.y, side.z}) key = key * 0x100000001b3ull ^ static_cast<uint64_t>(v + 8);
   return key;
@@ -242,14 +326,10 @@ void LightTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec3
                             Transfer* out, Transfer* reflected_out) {
   Trace(pixels);
   const ClearSky sky = ClearSkyUnder(sun_dir);
-  // The first bounce is kept apart from the direct terms for the per-surface means of the second.
-  std::vector<Transfer> reflected(pixels.size());
-  DirectAndFirstBounce(pixels, sun_dir, direct, sky, out, &reflected);
-  if (!options_.interreflection) {
-    if (reflected_out != nullptr) std::fill(reflected_out, reflected_out + pixels.size(), Transfer{});
-    return;
-  }
-  AddFurtherBounces(pixels, reflected, out, reflected_out);
+  const std::vector<Transfer> cell_light = options_.interreflection && options_.bounces > 1
+                                               ? SolveCells(sun_dir, sky)
+                                               : std::vector<Transfer>(cells_.size());
+  DirectAndReflected(pixels, sun_dir, direct, sky, cell_light, out, reflected_out);
 }
 
 LightTransfer::ClearSky LightTransfer::ClearSkyUnder(const glm::vec3& sun_dir) const {
@@ -260,17 +340,83 @@ LightTransfer::ClearSky LightTransfer::ClearSkyUnder(const glm::vec3& sun_dir) c
   sky.on = true;
   sky.inv_dhi = glm::vec3(1.0 / dhi);
   sky.open = OpenSkyIntegrals(sun_dir, sky.inv_dhi);
+  // π·L/DHI averaged over each cell's open rays: 1 for a uniform sky.
+  sky.cell_weight.assign(cells_.size(), glm::vec3(1.0f));
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, cells_.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t c = range.begin(); c != range.end(); ++c) {
+      const Cell& cell = cells_[c];
+      if (cell.sky_begin == cell.sky_end) continue;
+      glm::vec3 sum(0.0f);
+      for (uint32_t d = cell.sky_begin; d < cell.sky_end; ++d) sum += sky_.Radiance(UnpackDirection(cell_sky_[d]), sun_dir);
+      sky.cell_weight[c] = sum * sky.inv_dhi * glm::pi<float>() / static_cast<float>(cell.sky_end - cell.sky_begin);
+    }
+  });
   return sky;
 }
 
-void LightTransfer::DirectAndFirstBounce(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir,
-                                         const float* direct, const ClearSky& sky, Transfer* out,
-                                         std::vector<Transfer>* reflected) const {
+Transfer LightTransfer::DirectReflected(const Bounce& b, float sun_cos, const ClearSky& sky) const {
+  // How much more of the clear sky than of a uniform one b gets: the mean over its cell's rays that
+  // reach the sky (under an arcade, the low sky toward the sun), else what an open surface of b's
+  // orientation gets.
+  const OpenSky* open = sky.on ? &sky.open[b.orientation] : nullptr;
+  glm::vec3 clear_weight(1.0f);
+  if (b.cell != kNoCell && sky.on && cells_[b.cell].sky_begin != cells_[b.cell].sky_end) {
+    clear_weight = sky.cell_weight[b.cell];
+  } else if (open != nullptr && open->uniform > 1e-3f) {
+    clear_weight = open->clear / open->uniform;
+  }
+  return {b.albedo * sun_cos, b.albedo * b.sky_visibility * clear_weight, b.albedo * b.sky_visibility};
+}
+
+// Jacobi iteration from no reflected light: after k passes a cell holds what reaches it over k
+// bounces, so bounces − 1 passes give the points their full count.
+std::vector<Transfer> LightTransfer::SolveCells(const glm::vec3& sun_dir, const ClearSky& sky) const {
   const bool day = sun_dir.z > 0.0f;
-  // How much more of the clear sky than of a uniform one an open surface of each orientation gets.
-  const auto clear_weight = [&](uint32_t o) {
-    return sky.open[o].uniform > 1e-3f ? sky.open[o].clear / sky.open[o].uniform : glm::vec3(1.0f);
-  };
+  std::vector<Transfer> own(cell_bounces_.size());  // each hit's reflected direct light
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, cells_.size(), 16), [&](const tbb::blocked_range<size_t>& range) {
+    thread_local std::vector<glm::vec3> origins;
+    thread_local std::vector<uint32_t> facing;
+    thread_local std::vector<uint8_t> occluded;
+    for (size_t c = range.begin(); c != range.end(); ++c) {
+      origins.clear(), facing.clear();
+      for (uint32_t i = cells_[c].bounce_begin; day && i < cells_[c].bounce_end; ++i) {
+        if (glm::dot(cell_bounces_[i].normal, sun_dir) > 0.0f) origins.push_back(cell_bounces_[i].point), facing.push_back(i);
+      }
+      occluded.resize(origins.size());
+      caster_.OccludedAlong(origins.data(), origins.size(), sun_dir, 0.0f, occluded.data());
+      for (uint32_t i = cells_[c].bounce_begin; i < cells_[c].bounce_end; ++i) own[i] = DirectReflected(cell_bounces_[i], 0.0f, sky);
+      for (size_t j = 0; j < facing.size(); ++j) {
+        if (!occluded[j]) own[facing[j]].sun = cell_bounces_[facing[j]].albedo * glm::dot(cell_bounces_[facing[j]].normal, sun_dir);
+      }
+    }
+  });
+  const float inv_rays = 1.0f / static_cast<float>(options_.cell_rays);
+  std::vector<Transfer> light(cells_.size()), next(cells_.size());
+  for (int pass = 1; pass < options_.bounces; ++pass) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, cells_.size(), 64), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t c = range.begin(); c != range.end(); ++c) {
+        Transfer sum;
+        for (uint32_t i = cells_[c].bounce_begin; i < cells_[c].bounce_end; ++i) {
+          const Bounce& b = cell_bounces_[i];
+          Transfer t = own[i];
+          if (b.cell != kNoCell) {
+            const Transfer& further = light[b.cell];
+            t.sun += b.albedo * further.sun, t.clear += b.albedo * further.clear, t.overcast += b.albedo * further.overcast;
+          }
+          sum.sun += t.sun, sum.clear += t.clear, sum.overcast += t.overcast;
+        }
+        next[c] = {sum.sun * inv_rays, sum.clear * inv_rays, sum.overcast * inv_rays};
+      }
+    });
+    light.swap(next);
+  }
+  return light;
+}
+
+void LightTransfer::DirectAndReflected(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct,
+                                       const ClearSky& sky, const std::vector<Transfer>& cell_light, Transfer* out,
+                                       Transfer* reflected) const {
+  const bool day = sun_dir.z > 0.0f;
   const float inv_rays = 1.0f / static_cast<float>(hemisphere_.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels.size(), kGrain), [&](const tbb::blocked_range<size_t>& range) {
     // The bounce points' shadow rays all run along the sun: traced per pixel as packets.
@@ -293,8 +439,10 @@ void LightTransfer::DirectAndFirstBounce(const std::vector<uint32_t>& pixels, co
       }
       for (uint32_t i = paths.bounce_begin; i < paths.bounce_end; ++i) {
         const Bounce& b = bounces_[i];
-        r.overcast += b.albedo * b.sky_visibility;
-        r.clear += b.albedo * b.sky_visibility * (sky.on ? clear_weight(b.orientation) : glm::vec3(1.0f));
+        const Transfer own = DirectReflected(b, 0.0f, sky);
+        const Transfer& further = cell_light[b.cell];
+        r.clear += own.clear + b.albedo * further.clear, r.overcast += own.overcast + b.albedo * further.overcast;
+        r.sun += b.albedo * further.sun;
       }
       r.sun *= inv_rays, r.clear *= inv_rays, r.overcast *= inv_rays;
       // The direct sky: V from the bake's many rays for the uniform sky. For the clear one, what
@@ -312,52 +460,10 @@ void LightTransfer::DirectAndFirstBounce(const std::vector<uint32_t>& pixels, co
         t.clear = glm::max(sky.open[paths.orientation].clear + (low - blocked) * glm::pi<float>() * sky.inv_dhi * inv_rays,
                            glm::vec3(0.0f));
       }
-      out[k] = t;
-      (*reflected)[k] = r;
+      out[k] = {t.sun + r.sun, t.clear + r.clear, t.overcast + r.overcast};
+      if (reflected != nullptr) reflected[k] = r;
     }
   });
-}
-
-// Further bounces: each bounce point's own reflected light, as its surface's mean over these
-// pixels (surfaces without pixels here take the mean of all), iterated: the first pass gives the
-// second bounce, the next the third.
-void LightTransfer::AddFurtherBounces(const std::vector<uint32_t>& pixels, const std::vector<Transfer>& reflected,
-                                      Transfer* out, Transfer* reflected_out) const {
-  const float inv_rays = 1.0f / static_cast<float>(hemisphere_.size());
-  const size_t surfaces = bake_.albedo_table.size();
-  std::vector<Transfer> indirect = reflected;  // all reflected light found so far, per pixel
-  for (int bounce = 2; bounce <= options_.bounces; ++bounce) {
-    std::vector<Transfer> mean(surfaces + 1);
-    std::vector<double> count(surfaces + 1, 0.0);
-    for (size_t k = 0; k < pixels.size(); ++k) {
-      for (const size_t s : {std::min<size_t>(points_.surface[pixels[k]], surfaces), surfaces}) {
-        mean[s].sun += indirect[k].sun, mean[s].clear += indirect[k].clear, mean[s].overcast += indirect[k].overcast;
-        count[s] += 1.0;
-      }
-    }
-    for (size_t s = 0; s <= surfaces; ++s) {
-      const size_t from = count[s] > 0.0 ? s : surfaces;
-      const float scale = count[from] > 0.0 ? static_cast<float>(1.0 / count[from]) : 0.0f;
-      mean[s] = {mean[from].sun * scale, mean[from].clear * scale, mean[from].overcast * scale};
-    }
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels.size(), kGrain), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t k = range.begin(); k != range.end(); ++k) {
-        const Paths& paths = paths_[static_cast<size_t>(slot_[pixels[k]])];
-        Transfer further;
-        for (uint32_t i = paths.bounce_begin; i < paths.bounce_end; ++i) {
-          const Bounce& b = bounces_[i];
-          const Transfer& m = mean[std::min<size_t>(b.surface, surfaces)];
-          further.sun += b.albedo * m.sun, further.clear += b.albedo * m.clear, further.overcast += b.albedo * m.overcast;
-        }
-        indirect[k] = {reflected[k].sun + further.sun * inv_rays, reflected[k].clear + further.clear * inv_rays,
-                       reflected[k].overcast + further.overcast * inv_rays};
-      }
-    });
-  }
-  for (size_t k = 0; k < pixels.size(); ++k) {
-    out[k].sun += indirect[k].sun, out[k].clear += indirect[k].clear, out[k].overcast += indirect[k].overcast;
-    if (reflected_out != nullptr) reflected_out[k] = indirect[k];
-  }
 }
 
 }  // namespace daylit::estimation

@@ -14,11 +14,15 @@
 //
 // where the integrals run over x's hemisphere and y is the model point a direction ω hits. At y,
 // the direct terms are exact (s_y·max(0, n_y·l) by a shadow ray; V_y, times the clear sky's weight
-// for y's orientation) and y's own reflected light is its surface's mean over the traced points,
-// iterated for a third bounce (each bounce off walls of albedo ~0.3-0.5 adds a few percent
-// more). With a uniform sky and no reflection, T_sun = s·max(0, n·l) and T_clear = T_overcast = V:
-// the model of seed 001. The reflected terms are what a courtyard adds: shadowed ground lit by
-// sunlit walls, warm where the walls are red.
+// for y's orientation). y's own reflected light comes from a radiosity solve over cells of the
+// model's surfaces (one per 25 cm square of a surface side, 1 m for the cells those see): each
+// cell gathers once, by its own hemisphere of rays, which cells it sees and how much sky, and per
+// sun its irradiance is iterated from what those reflect (the second bounce, then the third).
+// Light under an overhang is local: a slab's sunlit top and its underside, or the sunlit and the
+// shadowed half of a wall, are different cells (a surface's mean over both put the top's light on
+// the underside, 25-50% too much on a wall under an arcade). With a uniform sky and no reflection,
+// T_sun = s·max(0, n·l) and T_clear = T_overcast = V: the model of seed 001. The reflected terms
+// are what a courtyard adds: shadowed ground lit by sunlit walls, warm where the walls are red.
 //
 // The paths (which directions reach the sky, which model points the rays hit, and their ρ_y and
 // V_y) do not depend on the sun, so they are traced once per point and kept; a new sun costs one
@@ -41,10 +45,11 @@ namespace daylit::estimation {
 
 struct TransferOptions {
   int rays = 256;               // cosine-weighted hemisphere rays per point
-  int hidden_sky_rays = 64;     // rays for V_y of bounce points the capture point does not see (per cell)
+  int cell_rays = 64;           // rays per cell of the radiosity solve (and V_y of bounce points the
+                                // capture point does not see)
   float offset_m = 2e-3f;       // ray origins are moved this far along the normal
   bool interreflection = true;  // the reflected terms
-  int bounces = 3;              // the first exact, the others through per-surface means
+  int bounces = 3;              // the first exact at each ray's hit, the others through the cells
   bool sky_distribution = true; // the captured sky's (θ, γ) distribution; false: a uniform sky
 
   // Empty when every field is in range, else the first problem, naming the field.
@@ -87,17 +92,31 @@ class LightTransfer {
   std::vector<glm::vec3> ClearSkyPerUnitDhi(const glm::vec3& sun_dir, const std::vector<glm::vec3>& dirs) const;
 
   size_t TracedPixels() const { return paths_.size(); }
+  size_t Cells() const { return cells_.size(); }
   // Whether T_clear differs from T_overcast: a captured sky with the sun up.
   bool HasSkyDistribution() const { return !sky_.empty(); }
 
  private:
+  static constexpr uint32_t kNoCell = 0xffffffffu;
   struct Bounce {
     glm::vec3 point;    // already moved off its surface
     glm::vec3 normal;
     glm::vec3 albedo;
-    float sky_visibility;
+    float sky_visibility;  // < 0 until known
     uint32_t surface;
-    uint32_t orientation;  // index into orientations_
+    uint32_t orientation;      // index into orientations_
+    uint32_t cell = kNoCell;   // index into cells_: where its own reflected light comes from
+  };
+  // A square of one side of a surface: the node of the radiosity solve.
+  struct Cell {
+    glm::vec3 origin;  // its centre dropped onto the plane of the bounce point that made it
+    glm::vec3 normal;
+    uint32_t level;    // 1: seen by the points, 2: seen by a level-1 cell, ...
+    bool traced = false;
+    bool expanded = false;  // its hits have cells
+    float sky_visibility = 0.0f;
+    uint32_t bounce_begin = 0, bounce_end = 0;  // into cell_bounces_
+    uint32_t sky_begin = 0, sky_end = 0;        // into cell_sky_: its rays that reach the sky
   };
   struct Paths {
     uint32_t orientation = 0;                     // of the pixel's normal
@@ -121,22 +140,33 @@ class LightTransfer {
     bool on = false;
     glm::vec3 inv_dhi{0.0f};
     std::vector<OpenSky> open;  // per orientation
+    std::vector<glm::vec3> cell_weight;  // per cell: π·L_clear/DHI over its open rays
   };
   // Traces the paths of the pixels not traced yet (Trace's steps follow).
   void Trace(const std::vector<uint32_t>& pixels);
   void TraceHemispheres(const std::vector<uint32_t>& fresh, std::vector<TracedPixel>* traced) const;
   Bounce BounceAt(const glm::vec3& y, const scene::RayHit& hit) const;
+  // Cells for the bounce points that have none (`level`: of the cells they get), traced with their
+  // hits' cells down to the level the bounces need; then V of every hidden bounce point.
+  void TraceCells(std::vector<TracedPixel>* traced);
+  uint32_t CellFor(const Bounce& b, uint32_t level);  // finds or adds (untraced) its cell
+  void TraceNewCells(const std::vector<uint32_t>& cells);
   void FillHiddenSkyVisibility(std::vector<TracedPixel>* traced);
   void StorePaths(const std::vector<uint32_t>& fresh, const std::vector<TracedPixel>& traced);
   // Compute's steps: the direct terms and the first bounce per pixel, then the further bounces.
   ClearSky ClearSkyUnder(const glm::vec3& sun_dir) const;
-  void DirectAndFirstBounce(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct,
-                            const ClearSky& sky, Transfer* out, std::vector<Transfer>* reflected) const;
-  void AddFurtherBounces(const std::vector<uint32_t>& pixels, const std::vector<Transfer>& reflected, Transfer* out,
-                         Transfer* reflected_out) const;
+  // What a bounce point reflects of its direct light per unit of each part: ρ_y times its direct
+  // sun (`sun_cos`: s_y·max(0, n_y·l)), clear and overcast terms.
+  Transfer DirectReflected(const Bounce& b, float sun_cos, const ClearSky& sky) const;
+  // Each cell's reflected irradiance (what reaches it from the cells it sees), iterated
+  // bounces − 1 times.
+  std::vector<Transfer> SolveCells(const glm::vec3& sun_dir, const ClearSky& sky) const;
+  void DirectAndReflected(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct,
+                          const ClearSky& sky, const std::vector<Transfer>& cell_light, Transfer* out,
+                          Transfer* reflected) const;
   uint32_t OrientationOf(const glm::vec3& normal);  // index into orientations_, added if new
-  static constexpr float kCellSize = 0.25f;         // m, for V of hidden bounce points
-  static uint64_t CellOf(const Bounce& b);          // surface, cell and side (hashed)
+  static constexpr float kCellSize = 0.25f;         // m, level-1 cells; deeper ones 4× that
+  static uint64_t CellKey(const Bounce& b, uint32_t level);  // surface, square, side and size (hashed)
   // What an unoccluded surface of each orientation receives from the clear sky and a uniform one.
   std::vector<OpenSky> OpenSkyIntegrals(const glm::vec3& sun_dir, const glm::vec3& inv_dhi) const;
 
@@ -153,7 +183,10 @@ class LightTransfer {
   std::vector<Bounce> bounces_;
   std::vector<glm::vec3> orientations_;  // distinct normals of pixels and bounce points (to ~1°)
   std::unordered_map<uint64_t, uint32_t> orientation_of_;
-  std::unordered_map<uint64_t, float> hidden_cells_;  // V per cell of hidden bounce points
+  std::vector<Cell> cells_;
+  std::vector<Bounce> cell_bounces_;              // the hits of each cell's rays
+  std::vector<uint32_t> cell_sky_;                // the others' directions, packed
+  std::unordered_map<uint64_t, uint32_t> cell_of_;  // CellKey -> index into cells_
 };
 
 }  // namespace daylit::estimation

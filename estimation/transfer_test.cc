@@ -57,7 +57,7 @@ TEST(TransferTest, OneBounceOffASunlitWallMatchesItsViewFactor) {
   w.bake.env = {};
   TransferOptions options;
   options.rays = 1024;
-  options.hidden_sky_rays = 256;
+  options.cell_rays = 256;
   options.bounces = 1;  // the analytic figure is for one bounce
   LightTransfer transfer(w.bake, TransferPoints::Camera(w.bake.camera), glm::vec3(w.scene.envmap->position), *w.caster, options);
   // The sun 45° high behind the camera lights the ground and the wall's face toward it.
