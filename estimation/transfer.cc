@@ -217,7 +217,8 @@ void LightTransfer::TraceNewCells(const std::vector<uint32_t>& cells) {
 }
 
 // V of the bounce points the capture point does not see (~5% of them on courtyard-a): their
-// cell's (V is smooth). Hits of the deepest cells have no cell: the mean V of their surface's cells.
+// cell's (V is smooth). Hits of the deepest cells have no cell of their own: a traced cell of their
+// square if there is one, else the mean V of their surface's cells.
 void LightTransfer::FillHiddenSkyVisibility(std::vector<TracedPixel>* traced) {
   for (TracedPixel& pixel : *traced) {
     for (Bounce& b : pixel.bounces) {
@@ -235,6 +236,14 @@ void LightTransfer::FillHiddenSkyVisibility(std::vector<TracedPixel>* traced) {
     }
   }
   for (Bounce& b : cell_bounces_) {
+    if (b.sky_visibility >= 0.0f) continue;
+    // A cell of its square traced for another path (a slab's underside is not its top).
+    for (const uint32_t level : {2u, 1u}) {
+      const auto cell = cell_of_.find(CellKey(b, level));
+      if (b.sky_visibility < 0.0f && cell != cell_of_.end() && cells_[cell->second].traced) {
+        b.sky_visibility = cells_[cell->second].sky_visibility;
+      }
+    }
     if (b.sky_visibility >= 0.0f) continue;
     const auto it = by_surface.find(b.surface);
     b.sky_visibility = it == by_surface.end() ? 0.5f : static_cast<float>(it->second.first / it->second.second);

@@ -26,6 +26,7 @@
 #include "bake/sampling.h"
 #include "bake/surface_light.h"
 #include "base/csv.h"
+#include "estimation/testing/reference_path_tracer.h"
 #include "estimation/transfer.h"
 #include "scene/hdr_image.h"
 #include "scene/raycaster.h"
@@ -45,33 +46,14 @@ float Median(std::vector<float> v) {
   return v[v.size() / 2];
 }
 
-// Irradiance at (x, n) per path tracing: sun by next-event estimation, sky on escape.
+// The path tracer's irradiance at (x, n) with the sky table scaled by `sky_scale`, less the
+// direct sun at x.
 glm::vec3 BruteIrradiance(const scene::RayCaster& caster, const glm::vec3& x, const glm::vec3& n,
                           const std::vector<glm::vec3>& albedo, const bake::SkyDistribution& sky, const glm::vec3& sky_scale,
                           const glm::vec3& sun, const glm::vec3& e_sun, int paths, int depth, std::mt19937& rng) {
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  glm::vec3 sum(0.0f);
-  for (int k = 0; k < paths; ++k) {
-    glm::vec3 p = x + 2e-3f * n, nn = n, throughput(1.0f);
-    for (int d = 0; d < depth; ++d) {
-      const float r1 = u(rng), r2 = u(rng);
-      const float rr = std::sqrt(r1), phi = 2.0f * glm::pi<float>() * r2;
-      const glm::vec3 local(rr * std::cos(phi), rr * std::sin(phi), std::sqrt(std::max(0.0f, 1.0f - r1)));
-      const glm::vec3 dir = bake::BasisAround(nn) * local;
-      const scene::RayHit hit = caster.Intersect(p, dir);
-      if (!hit.IsHit()) {
-        sum += throughput * sky.Radiance(dir, sun) * sky_scale * glm::pi<float>();
-        break;
-      }
-      const glm::vec3 y = p + hit.t * dir;
-      const glm::vec3 rho = albedo[hit.surface];
-      throughput *= rho;
-      p = y + 2e-3f * hit.normal, nn = hit.normal;
-      const float c = glm::dot(nn, sun);
-      if (c > 0.0f && !caster.Occluded(p, sun)) sum += throughput * e_sun * c;
-    }
-  }
-  return sum / static_cast<float>(paths);
+  const estimation::testing::ReferenceLight light{
+      sun, e_sun, [&](const glm::vec3& d) { return sky.Radiance(d, sun) * sky_scale; }, albedo};
+  return estimation::testing::PathTracedIndirectAndSky(caster, light, x, n, paths, depth, rng);
 }
 
 TEST(TransferTruthRecordingTest, BakeCaptureIrradianceMatchesAPathTracerOnCourtyardC) {
