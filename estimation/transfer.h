@@ -15,7 +15,7 @@
 // where the integrals run over x's hemisphere and y is the model point a direction ω hits. At y,
 // the direct terms are exact (s_y·max(0, n_y·l) by a shadow ray; V_y, times the clear sky's weight
 // for y's orientation). y's own reflected light comes from a radiosity solve over cells of the
-// model's surfaces (one per 25 cm square of a surface side, 1 m for the cells those see): each
+// model's surfaces (one per 50 cm square of a surface side, 2 m for the cells those see): each
 // cell gathers once, by its own hemisphere of rays, which cells it sees and how much sky, and per
 // sun its irradiance is iterated from what those reflect (the second bounce, then the third).
 // Light under an overhang is local: a slab's sunlit top and its underside, or the sunlit and the
@@ -165,7 +165,7 @@ class LightTransfer {
                           const ClearSky& sky, const std::vector<Transfer>& cell_light, Transfer* out,
                           Transfer* reflected) const;
   uint32_t OrientationOf(const glm::vec3& normal);  // index into orientations_, added if new
-  static constexpr float kCellSize = 0.25f;         // m, level-1 cells; deeper ones 4× that
+  static constexpr float kCellSize = 0.5f;          // m, level-1 cells; deeper ones 4× that
   static uint64_t CellKey(const Bounce& b, uint32_t level);  // surface, square, side and size (hashed)
   // What an unoccluded surface of each orientation receives from the clear sky and a uniform one.
   std::vector<OpenSky> OpenSkyIntegrals(const glm::vec3& sun_dir, const glm::vec3& inv_dhi) const;
