@@ -347,6 +347,17 @@ size_t CameraGBuffer::DiffuseCount() const {
 }
 
 
+SkyDistribution CapturedSky(const SceneBake& bake) {
+  const EnvMapMaps& env = bake.env;
+  HdrImage image{env.width, env.height, std::vector<float>(env.radiance.size() * 3)};
+  std::vector<uint8_t> is_sky(env.surface.size());
+  for (size_t t = 0; t < env.radiance.size(); ++t) {
+    for (int c = 0; c < 3; ++c) image.rgb[t * 3 + static_cast<size_t>(c)] = env.radiance[t][c];
+    is_sky[t] = env.IsSky(t) ? 1 : 0;
+  }
+  return SkyDistribution(image, is_sky, bake.capture_sun.dir);
+}
+
 SceneBake RunBake(const scene::Scene& scene, const BakeOptions& options) {
   if (!scene.envmap) ThrowInputError("{}: envmap: missing (the bake needs the HDR environment map)", scene.file.string());
   if (const std::string why = options.Check(); !why.empty()) ThrowInputError("bake options: {}", why);

@@ -86,6 +86,10 @@ std::string BakeHash(const scene::Scene& scene, const BakeOptions& options);
 // surface; warns about degenerate triangles.
 SceneBake RunBake(const scene::Scene& scene, const BakeOptions& options);
 
+// The captured sky of `bake`'s env maps (their sky texels, the sun disc removed) as a (θ, γ)
+// table about the capture sun.
+SkyDistribution CapturedSky(const SceneBake& bake);
+
 // Writes the bake into `dir`: env_maps.exr, camera_gbuffer.exr, gather.exr (multi-layer OpenEXR),
 // albedo.csv, bake.json and PNG previews. Each file is written to a temporary name and renamed;
 // bake.json last, so an interrupted save is never taken for a complete one.

@@ -69,4 +69,18 @@ glm::mat3 HemisphereFrame(const glm::vec3& n, uint32_t key) {
   return BasisAround(n) * spin;
 }
 
+uint64_t SurfaceCellKey(const glm::vec3& y, const glm::vec3& normal, uint64_t seed, float size) {
+  const glm::ivec3 cell(glm::floor(y / size));
+  const glm::ivec3 side(glm::round(normal * 8.0f));
+  uint64_t key = seed;
+  for (const int v : {cell.x, cell.y, cell.z}) key = key * 0x100000001b3ull ^ static_cast<uint64_t>(static_cast<uint32_t>(v));
+  for (const int v : {side.x, side.y, side.z}) key = key * 0x100000001b3ull ^ static_cast<uint64_t>(v + 8);
+  return key;
+}
+
+glm::vec3 SurfaceCellOrigin(const glm::vec3& y, const glm::vec3& normal, float size) {
+  const glm::vec3 centre = (glm::floor(y / size) + 0.5f) * size;
+  return centre - glm::dot(centre - y, normal) * normal;
+}
+
 }  // namespace daylit::bake

@@ -28,4 +28,11 @@ float RotationOf(uint32_t key);
 // pattern to the point with unit normal `n` and index `key`.
 glm::mat3 HemisphereFrame(const glm::vec3& n, uint32_t key);
 
+// Cells of the model's surfaces for gathering light once per patch instead of per point: a
+// `size`-metre square of one side of a surface. The key of the cell holding point y, its side
+// given by the unit `normal` facing it, hashed onto `seed` (its surface, and whatever else tells
+// cells apart), and the cell's centre dropped onto y's plane, where the cell gathers from.
+uint64_t SurfaceCellKey(const glm::vec3& y, const glm::vec3& normal, uint64_t seed, float size);
+glm::vec3 SurfaceCellOrigin(const glm::vec3& y, const glm::vec3& normal, float size);
+
 }  // namespace daylit::bake

@@ -96,12 +96,7 @@ void IntegrateCaptureIrradiance(const CaptureScene& capture, const RayOptions& o
 }
 
 uint64_t HiddenSurfaceModel::CellKey(const glm::vec3& y, const glm::vec3& normal, uint32_t surface) {
-  const glm::ivec3 cell(glm::floor(y / kCellSize));
-  const glm::ivec3 side(glm::round(normal * 8.0f));
-  uint64_t key = surface;
-  for (const int v : {cell.x, cell.y, cell.z}) key = key * 0x100000001b3ull ^ static_cast<uint64_t>(static_cast<uint32_t>(v));
-  for (const int v : {side.x, side.y, side.z}) key = key * 0x100000001b3ull ^ static_cast<uint64_t>(v + 8);
-  return key;
+  return SurfaceCellKey(y, normal, surface, kCellSize);
 }
 
 glm::vec3 HiddenSurfaceModel::IndirectAt(const glm::vec3& y, const glm::vec3& normal, uint32_t surface) const {
@@ -149,9 +144,8 @@ void GatherHiddenCells(const CaptureScene& capture, const RayOptions& options, c
   tbb::parallel_for(tbb::blocked_range<size_t>(0, list.size(), 16), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t k = range.begin(); k != range.end(); ++k) {
       const Found& f = list[k].second;
-      const float size = HiddenSurfaceModel::kCellSize;
-      const glm::vec3 centre = (glm::floor(f.point / size) + 0.5f) * size;
-      const glm::vec3 origin = centre - glm::dot(centre - f.point, f.normal) * f.normal + options.offset_m * f.normal;
+      const glm::vec3 origin =
+          SurfaceCellOrigin(f.point, f.normal, HiddenSurfaceModel::kCellSize) + options.offset_m * f.normal;
       const glm::mat3 frame = HemisphereFrame(f.normal, static_cast<uint32_t>(list[k].first));
       glm::vec3 sum(0.0f);
       for (const glm::vec3& local : hemisphere) {

@@ -33,13 +33,6 @@ glm::vec3 UnpackDirection(uint32_t p) {
   return glm::normalize(q);
 }
 
-HdrImage ImageOf(const bake::EnvMapMaps& env) {
-  HdrImage image{env.width, env.height, std::vector<float>(env.radiance.size() * 3)};
-  for (size_t t = 0; t < env.radiance.size(); ++t) {
-    for (int c = 0; c < 3; ++c) image.rgb[t * 3 + static_cast<size_t>(c)] = env.radiance[t][c];
-  }
-  return image;
-}
 
 }  // namespace
 
@@ -64,9 +57,7 @@ LightTransfer::LightTransfer(const bake::SceneBake& bake, TransferPoints points,
   // The captured sky's shape only means something with the sun up at capture time: the (θ, γ)
   // table is relative to that sun.
   if (options.sky_distribution && bake.capture_sun.above_horizon && !bake.env.radiance.empty()) {
-    std::vector<uint8_t> is_sky(bake.env.surface.size());
-    for (size_t t = 0; t < is_sky.size(); ++t) is_sky[t] = bake.env.IsSky(t) ? 1 : 0;
-    sky_ = bake::SkyDistribution(ImageOf(bake.env), is_sky, bake.capture_sun.dir);
+    sky_ = bake::CapturedSky(bake);
   }
 }
 
@@ -141,7 +132,6 @@ void LightTransfer::TraceHemispheres(const std::vector<uint32_t>& fresh, std::ve
 // met deeper and later by a point keeps its trace and gets its hits' cells then.
 void LightTransfer::TraceCells(std::vector<TracedPixel>* traced) {
   const uint32_t deepest = static_cast<uint32_t>(std::max(1, options_.bounces - 1));
-  std::vector<uint32_t> level;
   for (TracedPixel& pixel : *traced) {
     for (Bounce& b : pixel.bounces) b.cell = CellFor(b, 1);
   }
@@ -166,9 +156,7 @@ void LightTransfer::TraceCells(std::vector<TracedPixel>* traced) {
 uint32_t LightTransfer::CellFor(const Bounce& b, uint32_t level) {
   const auto [it, inserted] = cell_of_.emplace(CellKey(b, std::min(level, 2u)), static_cast<uint32_t>(cells_.size()));
   if (inserted) {
-    const float size = level == 1 ? kCellSize : kDeepCellScale * kCellSize;
-    const glm::vec3 centre = (glm::floor(b.point / size) + 0.5f) * size;
-    cells_.push_back({centre - glm::dot(centre - b.point, b.normal) * b.normal, b.normal, level});
+    cells_.push_back({bake::SurfaceCellOrigin(b.point, b.normal, CellEdge(level)), b.normal, level});
   } else if (cells_[it->second].level > level) {
     cells_[it->second].level = level;
   }
@@ -272,14 +260,10 @@ void LightTransfer::StorePaths(const std::vector<uint32_t>& fresh, const std::ve
   }
 }
 
+float LightTransfer::CellEdge(uint32_t level) { return level == 1 ? kCellSize : kDeepCellScale * kCellSize; }
+
 uint64_t LightTransfer::CellKey(const Bounce& b, uint32_t level) {
-  const float size = level == 1 ? kCellSize : kDeepCellScale * kCellSize;
-  const glm::ivec3 cell(glm::floor(b.point / size));
-  const glm::ivec3 side(glm::round(b.normal * 8.0f));
-  uint64_t key = b.surface * 4ull + level;
-  for (const int v : {cell.x, cell.y, cell.z}) key = key * 0x100000001b3ull ^ static_cast<uint64_t>(static_cast<uint32_t>(v));
-  for (const int v : {side.x, side.y, side.z}) key = key * 0x100000001b3ull ^ static_cast<uint64_t>(v + 8);
-  return key;
+  return bake::SurfaceCellKey(b.point, b.normal, b.surface * 4ull + level, CellEdge(level));
 }
 
 uint32_t LightTransfer::OrientationOf(const glm::vec3& normal) {

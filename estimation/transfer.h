@@ -166,7 +166,8 @@ class LightTransfer {
                           Transfer* reflected) const;
   uint32_t OrientationOf(const glm::vec3& normal);  // index into orientations_, added if new
   static constexpr float kCellSize = 0.5f;          // m, level-1 cells; deeper ones 4× that
-  static uint64_t CellKey(const Bounce& b, uint32_t level);  // surface, square, side and size (hashed)
+  static float CellEdge(uint32_t level);                     // m
+  static uint64_t CellKey(const Bounce& b, uint32_t level);  // bake::SurfaceCellKey at that level's size
   // What an unoccluded surface of each orientation receives from the clear sky and a uniform one.
   std::vector<OpenSky> OpenSkyIntegrals(const glm::vec3& sun_dir, const glm::vec3& inv_dhi) const;
 

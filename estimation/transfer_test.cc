@@ -143,13 +143,7 @@ TEST(TransferTest, ArcadeBackWallMatchesAPathTracerPerPartOfTheLight) {
   std::vector<Transfer> t(wall.size());
   transfer.Compute(wall, sun, direct.data(), t.data());
   // The path tracer's skies per unit DHI: the table daylit evaluates for this sun, and a uniform one.
-  HdrImage env{w.bake.env.width, w.bake.env.height, std::vector<float>(w.bake.env.radiance.size() * 3)};
-  std::vector<uint8_t> is_sky(w.bake.env.surface.size());
-  for (size_t i = 0; i < is_sky.size(); ++i) {
-    for (int c = 0; c < 3; ++c) env.rgb[i * 3 + static_cast<size_t>(c)] = w.bake.env.radiance[i][c];
-    is_sky[i] = w.bake.env.IsSky(i) ? 1 : 0;
-  }
-  const bake::SkyDistribution table(env, is_sky, sun);
+  const bake::SkyDistribution table = bake::CapturedSky(w.bake);  // about `sun`, the capture sun
   const glm::vec3 inv_dhi(1.0 / table.HorizontalIrradiance(sun));
   const auto clear = [&](const glm::vec3& d) { return d.z > 0.0f ? table.Radiance(d, sun) * inv_dhi : glm::vec3(0.0f); };
   const auto uniform = [](const glm::vec3& d) { return glm::vec3(d.z > 0.0f ? glm::one_over_pi<float>() : 0.0f); };

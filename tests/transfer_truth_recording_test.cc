@@ -60,13 +60,7 @@ TEST(TransferTruthRecordingTest, BakeCaptureIrradianceMatchesAPathTracerOnCourty
   const testing::BundledCourtyard& c = testing::CourtyardC();
   const scene::RayCaster caster(c.scene.model);
   const bake::EnvMapMaps& e = c.bake.env;
-  HdrImage env{e.width, e.height, std::vector<float>(e.radiance.size() * 3)};
-  std::vector<uint8_t> is_sky(e.surface.size());
-  for (size_t t = 0; t < is_sky.size(); ++t) {
-    for (int ch = 0; ch < 3; ++ch) env.rgb[t * 3 + ch] = e.radiance[t][ch];
-    is_sky[t] = e.IsSky(t);
-  }
-  const bake::SkyDistribution sky(env, is_sky, c.bake.capture_sun.dir);
+  const bake::SkyDistribution sky = bake::CapturedSky(c.bake);
   std::vector<glm::vec3> rho(c.scene.model.surface_names.size(), glm::vec3(0.3f));
   for (size_t s = 0; s < c.bake.albedo_table.size(); ++s) rho[s] = c.bake.albedo_table[s].albedo;
   const std::string dir = DAYLIT_SOURCE_DIR "/recordings/courtyard-c/";
@@ -126,13 +120,7 @@ void ClearFrames(const testing::BundledCourtyard& c, const std::string& recordin
       if (s >= 0) true_albedo[static_cast<size_t>(s)] = glm::vec3(v[0].get<float>(), v[1].get<float>(), v[2].get<float>());
     }
   }
-  HdrImage env{c.bake.env.width, c.bake.env.height, std::vector<float>(c.bake.env.radiance.size() * 3)};
-  std::vector<uint8_t> is_sky(c.bake.env.surface.size());
-  for (size_t t = 0; t < is_sky.size(); ++t) {
-    for (int ch = 0; ch < 3; ++ch) env.rgb[t * 3 + ch] = c.bake.env.radiance[t][ch];
-    is_sky[t] = c.bake.env.IsSky(t);
-  }
-  const bake::SkyDistribution sky(env, is_sky, c.bake.capture_sun.dir);
+  const bake::SkyDistribution sky = bake::CapturedSky(c.bake);
   for (const int frame : frames) {
     const HdrImage L = scene::ReadHdrImage(fmt::format("{}groundtruth/without_objects/{:06d}.exr", dir, frame));
     scene::SunTracker tracker(c.scene);
