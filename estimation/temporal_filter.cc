@@ -48,12 +48,13 @@ FilteredLight TemporalFilter::Update(double time_s, const std::optional<SunSky>&
   }
   // While the window fills after a restart, the median of what there is.
   const SunSky target = WindowMedian(window_);
-  // Per channel, a change within the noise band (a share of the channel's E_sun + E_sky) is
-  // smoothed with gain `smoothing`; what lies beyond it is taken at once. Noise is damped, a
-  // cloud edge is followed on the frame it arrives, lagging by at most (1 − gain)·band.
+  // Per channel, a change within the noise band (a share of the value itself) is smoothed with
+  // gain `smoothing`; what lies beyond it is taken at once. Noise is damped, a cloud edge is
+  // followed on the frame it arrives, lagging by at most (1 − gain)·band. A band shared by E_sun
+  // and E_sky would be a third of E_sky under a strong low sun and hold the sky back for frames.
   for (int c = 0; c < 3; ++c) {
-    const double band = options_.noise_band * (state_->light.sun_rgb[c] + state_->light.sky_rgb[c]);
     for (double* value : {&state_->light.sun_rgb[c], &state_->light.sky_rgb[c]}) {
+      const double band = options_.noise_band * *value;
       const double d = (value == &state_->light.sun_rgb[c] ? target.sun_rgb[c] : target.sky_rgb[c]) - *value;
       const double small = std::clamp(d, -band, band);
       *value += options_.smoothing * small + (d - small);

@@ -18,11 +18,23 @@ TEST(TemporalFilterTest, ACloudShowsOnTheFrameItArrives) {
     sun.push_back(filter.Update(0.1 * f, Light(f < 10 ? 100.0 : 20.0, 10.0), 1.0).light.sun_rgb.x);
   }
   EXPECT_NEAR(sun[9], 100.0, 1e-9);
-  // The step beyond the noise band (3% of E_sun + E_sky = 3.3) is taken at once, leaving 0.7 of
-  // the band; then the band is the new light's, and what lies beyond it again goes at once.
-  EXPECT_NEAR(sun[10], 20.0 + 0.7 * 3.3, 1e-9);
-  EXPECT_LE(sun[11] - 20.0, 0.7 * 0.03 * (sun[10] + 10.0) + 1e-9);
+  // The step beyond the noise band (3% of E_sun = 3.0) is taken at once, leaving 0.7 of the band;
+  // then the band is the new light's, and what lies beyond it again goes at once.
+  EXPECT_NEAR(sun[10], 20.0 + 0.7 * 3.0, 1e-9);
+  EXPECT_LE(sun[11] - 20.0, 0.7 * 0.03 * sun[10] + 1e-9);
   EXPECT_LT(std::abs(sun[14] - 20.0), 0.005 * 80.0);  // within 0.5% of the step after 4 frames
+}
+
+TEST(TemporalFilterTest, TheSkyFollowsItsOwnStepUnderAStrongSun) {
+  // A cloud leaves the sky around a low sun: E_sky drops 30% while E_sun holds at ten times it.
+  // The sky's band is 3% of the sky, not of sun + sky (which would be a third of the sky here and
+  // smooth the step over frames: courtyard-c's clearing frames had E_sky 34% high that way).
+  TemporalFilter filter;
+  std::vector<double> sky;
+  for (int f = 0; f < 12; ++f) sky.push_back(filter.Update(0.1 * f, Light(100.0, f < 10 ? 13.0 : 10.0), 1.0).light.sky_rgb.y);
+  EXPECT_NEAR(sky[9], 13.0, 1e-9);
+  EXPECT_LE(sky[10] / 10.0 - 1.0, 0.7 * 0.03 * 13.0 / 10.0 + 1e-9);  // within 2.8% on the frame
+  EXPECT_LE(sky[11] / 10.0 - 1.0, 0.7 * 0.03 + 1e-9);
 }
 
 TEST(TemporalFilterTest, AMedianWindowStopsASingleWildFit) {

@@ -74,13 +74,15 @@ void ExpectPerBurst(const testing::BundledCourtyard& c, const std::vector<BurstB
 }
 
 TEST(EstimateRecordingTest, CourtyardAEveryBurstWithin5Percent) {
-  // Burst 3 is overcast: the sun is 12% of its beam and E_sun blue reads 6.6% high.
-  ExpectPerBurst(testing::Courtyard(), {{3, 0.08, 0.05}}, 0.12);
+  // Burst 3 is overcast: the sun is 12% of its beam and E_sun blue reads 6.5% high. The 90th
+  // percentile of the worst channel is the bar (measured 7.5%).
+  ExpectPerBurst(testing::Courtyard(), {{3, 0.08, 0.05}}, 0.10);
 }
 
 TEST(EstimateRecordingTest, CourtyardCEveryBurstWithin5Percent) {
-  // Burst 1: E_sky red 8.9% high (the arcade wall's albedo, 4.6% low, is most of the shadow).
-  ExpectPerBurst(testing::CourtyardC(), {{1, 0.05, 0.10}}, 0.12);
+  // Burst 1: E_sky red 8.6% high (the arcade wall's albedo, 4.6% low, is most of the shadow).
+  // The 90th percentile: measured 8.8%.
+  ExpectPerBurst(testing::CourtyardC(), {{1, 0.05, 0.10}}, 0.10);
 }
 
 }  // namespace
