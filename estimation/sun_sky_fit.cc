@@ -90,7 +90,9 @@ std::string SunSkyFitOptions::Check() const {
   return FirstProblem({InOpenClosed("cauchy_scale", cauchy_scale, 0.0, 10.0), InClosed("iterations", iterations, 1, 1000),
                        InOpenClosed("sunlit_threshold", sunlit_threshold, 0.0, 0.999),
                        InClosed("min_stratum_samples", min_stratum_samples, 1, 1000000),
-                       InOpenClosed("confident_residual", confident_residual, 0.0, 10.0)});
+                       InOpenClosed("confident_residual", confident_residual, 0.0, 10.0),
+                       InOpenClosed("confident_share", confident_share, 0.0, 1.0),
+                       InOpenClosed("absent_sun_share", absent_sun_share, 0.0, confident_share)});
 }
 
 namespace {
@@ -242,13 +244,49 @@ double PooledOvercastShare(ChannelFitter* fitter, const std::vector<size_t>& usa
   return sky > 0.0 ? glm::compAdd(overcast) / sky : 0.0;
 }
 
-// Confidence: small robust residuals, and both strata present (sunlit and shadowed samples are
-// what separates E_sun from E_sky; without sunlit ones E_sun is not observed at all).
+// The worst channel's share of the sunlit samples' predicted light that is direct sun, and of the
+// shadowed samples' that is sky (SunSkyFitSummary); 1 for a stratum without samples.
+void SplitShares(const SunSkyFitOptions& options, const std::vector<Sample>& samples, const std::vector<size_t>& usable,
+                 SunSkyFitSummary* summary) {
+  glm::dvec3 sun_lit(0.0), all_lit(0.0), sky_shadow(0.0), all_shadow(0.0);
+  const double o = summary->overcast_share;
+  for (const size_t i : usable) {
+    const Sample& s = samples[i];
+    const bool lit = IsSunlit(s, options);
+    if (!lit && s.sunlit) continue;  // grazing sun: neither stratum
+    const glm::dvec3 sun = glm::dvec3(s.albedo) * glm::dvec3(s.sun) * summary->light.sun_rgb;
+    const glm::dvec3 sky = glm::dvec3(s.albedo) * ((1.0 - o) * glm::dvec3(s.sky) + o * glm::dvec3(s.overcast)) *
+                           summary->light.sky_rgb;
+    // Each sample weighs as its share (a mean of shares, not a share of sums: bright points do
+    // not outvote dim ones).
+    const glm::dvec3 total = glm::max(sun + sky, glm::dvec3(1e-30));
+    if (lit) {
+      sun_lit += sun / total, all_lit += glm::dvec3(1.0);
+    } else {
+      sky_shadow += sky / total, all_shadow += glm::dvec3(1.0);
+    }
+  }
+  summary->sun_share_sunlit = all_lit.x > 0.0 ? glm::compMin(sun_lit / all_lit) : 1.0;
+  summary->sky_share_shadowed = all_shadow.x > 0.0 ? glm::compMin(sky_shadow / all_shadow) : 1.0;
+}
+
+// A share's factor on the confidence: 1 from `confident_share` up, proportional below it.
+double ShareFactor(const SunSkyFitOptions& options, double share) { return std::min(1.0, share / options.confident_share); }
+
+// Confidence: small robust residuals, both strata present (sunlit and shadowed samples are what
+// separates E_sun from E_sky; without sunlit ones E_sun is not observed at all), and a well-posed
+// split. The sun's share factor falls with the sun's share down to `absent_sun_share`; below it
+// the sun counts as absent (an overcast frame: E_sun ≈ 0 is then what the samples say, and well
+// said), so the factor rises linearly back to 1 at a share of 0, with no jump.
 double Confidence(const SunSkyFitOptions& options, const SunSkyFitSummary& summary, bool with_sun) {
   const double fit_quality = std::exp(-std::pow(summary.residual_spread / options.confident_residual, 2.0));
   const double strata = std::min(1.0, static_cast<double>(summary.shadowed_samples) / options.min_stratum_samples) *
                         (with_sun ? std::min(1.0, static_cast<double>(summary.sunlit_samples) / options.min_stratum_samples) : 1.0);
-  return fit_quality * strata * summary.inlier_share;
+  const double s = summary.sun_share_sunlit, s0 = options.absent_sun_share;
+  const double at_s0 = ShareFactor(options, s0);
+  const double sun_split = !with_sun ? 1.0 : s >= s0 ? ShareFactor(options, s) : 1.0 - (1.0 - at_s0) * s / s0;
+  const double sky_split = ShareFactor(options, summary.sky_share_shadowed);
+  return fit_quality * strata * summary.inlier_share * sun_split * sky_split;
 }
 
 }  // namespace
@@ -306,6 +344,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   size_t inliers = 0;
   for (const double r : all_residuals) inliers += r < 3.0 * options.cauchy_scale ? 1 : 0;
   summary.inlier_share = static_cast<double>(inliers) / static_cast<double>(all_residuals.size());
+  SplitShares(options, samples, usable, &summary);
   summary.confidence = Confidence(options, summary, with_sun);
   summary.status = unconverged_channels > 0 ? SunSkyFitStatus::kNoConvergence
                    : with_sun                ? SunSkyFitStatus::kConverged

@@ -46,6 +46,10 @@ struct SunSkyFitOptions {
   int min_stratum_samples = 30;     // per stratum (sunlit, shadowed) for full confidence
   double confident_residual = 0.25; // robust relative residual spread at which confidence is 1/e
                                     // (textured albedo and model gaps leave ~0.1-0.2 on real scenes)
+  double confident_share = 0.5;     // a stratum's light this much from the term it measures (the sun
+                                    // on sunlit samples, the sky on shadowed ones): a well-posed split
+  double absent_sun_share = 0.05;   // below this share of the sunlit samples' light the sun counts
+                                    // as absent (overcast): the split's conditioning is the sky's
   bool split_sky = true;            // fit E_clear and E_overcast apart (when the samples differ)
 
   // Empty when every field is in range, else the first problem, naming the field.
@@ -69,6 +73,13 @@ struct SunSkyFitSummary {
   int sunlit_samples = 0;
   int shadowed_samples = 0;
   double inlier_share = 0.0;    // samples with |relative residual| < 3·cauchy_scale
+  // How well the sun/sky split is posed, from the fitted light (worst channel): the share of the
+  // sunlit samples' predicted light that is direct sun, and of the shadowed samples' that is sky
+  // (1 without such samples). A stratum lit mostly by the other term passes that term's model
+  // error on, amplified by 1/share − 1: a weak sun behind thin cloud, shadows lit mostly by sun
+  // reflected from nearby walls.
+  double sun_share_sunlit = 1.0;
+  double sky_share_shadowed = 1.0;
   std::string message;
 
   bool IsUsable() const { return status != SunSkyFitStatus::kTooFewSamples; }

@@ -132,6 +132,43 @@ TEST(SunSkyFitTest, OvercastGivesNoSunWithConfidence) {
   EXPECT_GT(fit.confidence, 0.8);
 }
 
+TEST(SunSkyFitTest, AnIllPosedSplitLowersTheConfidence) {
+  // The same exact samples under three lights. A sun at 4% of its clear beam behind thin cloud:
+  // the sunlit samples' light is mostly sky, so any model error in the sky's part passes to E_sun
+  // amplified (the recordings' worst E_sun frames are such). Shadows lit mostly by sun reflected
+  // from nearby walls pass the sun's model error to E_sky. Both fits are exact here (the samples
+  // are the model's), yet the confidence must say how much a model error would move them.
+  std::mt19937 rng(8);
+  const std::vector<Sample> clear_samples = MakeSamples(kClear, 5000, rng);
+  const SunSkyFitSummary clear = FitSunSky({}, clear_samples);
+  EXPECT_GT(clear.sun_share_sunlit, 0.5);
+  EXPECT_GT(clear.sky_share_shadowed, 0.5);
+  EXPECT_GT(clear.confidence, 0.99);
+
+  const SunSky thin{kClear.sun_rgb * 0.04, kClear.sky_rgb * 2.0};
+  std::mt19937 rng_thin(8);
+  const SunSkyFitSummary weak = FitSunSky({}, MakeSamples(thin, 5000, rng_thin));
+  ExpectNear(weak.light, thin, 1e-3);
+  EXPECT_LT(weak.sun_share_sunlit, 0.25);
+  EXPECT_LT(weak.confidence, 0.5);
+  EXPECT_GT(weak.confidence, 0.1);  // still usable: the filter takes it
+
+  std::mt19937 rng_bounce(8);
+  std::vector<Sample> bounced = MakeSamples(kClear, 5000, rng_bounce);
+  for (Sample& s : bounced) {
+    if (s.sunlit) continue;
+    s.sun *= 4.0f;  // an arcade's back wall: lit by the sunlit ground in front of it
+    for (int c = 0; c < 3; ++c) {
+      s.radiance[c] = static_cast<float>(s.albedo[c] / glm::pi<double>() *
+                                         (s.sun[c] * kClear.sun_rgb[c] + s.sky[c] * kClear.sky_rgb[c]));
+    }
+  }
+  const SunSkyFitSummary reflected = FitSunSky({}, bounced);
+  ExpectNear(reflected.light, kClear, 1e-3);
+  EXPECT_LT(reflected.sky_share_shadowed, 0.3);
+  EXPECT_LT(reflected.confidence, 0.6);
+}
+
 TEST(SunSkyFitTest, SunBelowTheHorizonFitsTheSkyAlone) {
   std::mt19937 rng(5);
   std::vector<Sample> samples = MakeSamples({{0, 0, 0}, {1.2, 1.5, 2.1}}, 2000, rng);

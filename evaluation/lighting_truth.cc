@@ -10,6 +10,7 @@
 #include <glm/gtx/component_wise.hpp>
 
 #include "base/atomic_file.h"
+#include "base/check.h"
 #include "base/csv.h"
 #include "base/statistics.h"
 #include "report/plot.h"
@@ -64,12 +65,39 @@ TruthComparison CompareWithTruth(const std::vector<estimation::FrameEstimate>& f
     std::sort(worst.begin(), worst.end());
     cmp.p90_worst_channel_error = worst[std::min(worst.size() - 1, static_cast<size_t>(0.9 * static_cast<double>(worst.size())))];
   }
+  std::vector<double> confidence;
+  for (const estimation::FrameEstimate& f : frames) confidence.push_back(f.confidence);
+  cmp.ranking = RankByConfidence(confidence, cmp.worst_channel_error);
   for (int k = 0; k < 3; ++k) {
     cmp.sun_error[k] = Median(sun[static_cast<size_t>(k)]);
     cmp.sky_error[k] = Median(sky[static_cast<size_t>(k)]);
     cmp.ratio_error[k] = Median(ratio[static_cast<size_t>(k)]);
   }
   return cmp;
+}
+
+ConfidenceRanking RankByConfidence(const std::vector<double>& confidence, const std::vector<double>& error) {
+  DAYLIT_CHECK(confidence.size() == error.size(), "{} confidences for {} errors", confidence.size(), error.size());
+  std::vector<double> bad, good;
+  for (size_t i = 0; i < error.size(); ++i) {
+    if (error[i] > kBadFrameError) bad.push_back(confidence[i]);
+    if (error[i] <= kGoodFrameError) good.push_back(confidence[i]);
+  }
+  ConfidenceRanking r;
+  r.bad_frames = static_cast<int>(bad.size()), r.good_frames = static_cast<int>(good.size());
+  if (bad.empty() || good.empty()) return r;
+  std::sort(good.begin(), good.end());
+  double wins = 0.0;
+  int below_90 = 0;
+  for (const double b : bad) {
+    const auto lo = std::lower_bound(good.begin(), good.end(), b), hi = std::upper_bound(good.begin(), good.end(), b);
+    const double above = static_cast<double>(good.end() - hi), tied = static_cast<double>(hi - lo);
+    wins += above + 0.5 * tied;
+    below_90 += above >= 0.9 * static_cast<double>(good.size()) ? 1 : 0;
+  }
+  r.auc = wins / (static_cast<double>(bad.size()) * static_cast<double>(good.size()));
+  r.bad_below_90_percent_of_good = static_cast<double>(below_90) / static_cast<double>(bad.size());
+  return r;
 }
 
 std::vector<Burst> SplitBursts(const std::vector<estimation::FrameEstimate>& frames, double gap_s) {
@@ -234,6 +262,16 @@ std::optional<TruthComparison> ReportLighting(const scene::Scene& scene, const s
     line("sun/sky", truth->ratio_error);
     report->Say(fmt::format("  90th percentile over frames of the worst channel's error (E_sun and E_sky): {:.1f}%",
                             100 * truth->p90_worst_channel_error));
+    const ConfidenceRanking& rank = truth->ranking;
+    if (rank.bad_frames > 0 && rank.good_frames > 0) {
+      report->Say(fmt::format("  confidence ranking: {} frames over 10% against {} within 5%: AUC {:.2f}; {:.0f}% of those "
+                              "frames score below 90% of the good ones",
+                              rank.bad_frames, rank.good_frames, rank.auc, 100 * rank.bad_below_90_percent_of_good));
+      report->Figure("lighting/confidence_auc", rank.auc);
+    } else {
+      report->Say(fmt::format("  confidence ranking: {} frames over 10%, {} within 5% (no ranking without both)",
+                              rank.bad_frames, rank.good_frames));
+    }
     report->Figure("lighting/frames", truth->frames);
     report->Figure("lighting/p90_worst_channel_error", truth->p90_worst_channel_error);
     for (int c = 0; c < 3; ++c) {

@@ -15,6 +15,16 @@
 
 namespace daylit::evaluation {
 
+struct ConfidenceRanking {
+  int bad_frames = 0, good_frames = 0;  // worst channel > 10%, ≤ 5%
+  double auc = NAN;
+  // The share of bad frames that score below at least 90% of the good ones.
+  double bad_below_90_percent_of_good = NAN;
+};
+constexpr double kBadFrameError = 0.10, kGoodFrameError = 0.05;
+// `confidence` and `error` aligned; frames with a NaN error are left out.
+ConfidenceRanking RankByConfidence(const std::vector<double>& confidence, const std::vector<double>& error);
+
 // Against groundtruth.csv: median over frames of |estimate/truth − 1| per channel, for E_sun
 // (frames where the true E_sun is > 0), E_sky, and the sun/sky ratio. Throws InputError naming
 // the file and row for a malformed table.
@@ -26,6 +36,10 @@ struct TruthComparison {
   // where its truth is > 0); NaN without truth. Its 90th percentile over the frames with truth.
   std::vector<double> worst_channel_error;
   double p90_worst_channel_error = NAN;
+  // Whether the confidence ranks frames by their error: the ROC AUC of "confidence lower" for the
+  // frames whose worst channel is off by more than 10% against those within 5% (the probability
+  // that such a bad frame scores below such a good one, ties half). NaN without both kinds.
+  ConfidenceRanking ranking;
 };
 TruthComparison CompareWithTruth(const std::vector<estimation::FrameEstimate>& frames,
                                  const std::filesystem::path& groundtruth_csv);

@@ -64,5 +64,22 @@ TEST(LightingTruthTest, EachBurstHasItsOwnMedianErrors) {
   EXPECT_TRUE(std::isnan(CompareBursts(frames, nullptr)[0].sun_error.x));
 }
 
+TEST(LightingTruthTest, ConfidenceRankingIsTheAucOfBadFramesAgainstGoodOnes) {
+  // Errors: two bad frames (> 10%), three good (≤ 5%), one in between and one without truth,
+  // which count as neither.
+  const std::vector<double> error = {0.20, 0.11, 0.01, 0.02, 0.05, 0.07, NAN};
+  // Every bad frame below every good one: 1; every one above: 0.
+  EXPECT_DOUBLE_EQ(RankByConfidence({0.1, 0.2, 0.9, 0.8, 0.7, 0.0, 0.0}, error).auc, 1.0);
+  EXPECT_DOUBLE_EQ(RankByConfidence({0.9, 0.95, 0.1, 0.2, 0.3, 1.0, 1.0}, error).auc, 0.0);
+  // The first bad frame below all three good ones (3); the second above one, tied with one and
+  // below one (1 + 0.5): 4.5 of 6 pairs.
+  const ConfidenceRanking r = RankByConfidence({0.1, 0.8, 0.9, 0.8, 0.7, 0.0, 0.0}, error);
+  EXPECT_EQ(r.bad_frames, 2);
+  EXPECT_EQ(r.good_frames, 3);
+  EXPECT_DOUBLE_EQ(r.auc, (3.0 + 1.0 + 0.5) / 6.0);
+  EXPECT_DOUBLE_EQ(r.bad_below_90_percent_of_good, 0.5);
+  EXPECT_TRUE(std::isnan(RankByConfidence({0.5, 0.5}, {0.01, 0.02}).auc));  // no bad frame
+}
+
 }  // namespace
 }  // namespace daylit::evaluation
