@@ -57,6 +57,9 @@ FrameLight FrameEstimator::Estimate(const capture::Frame& frame, const scene::Tr
   out.row.light = filtered.light;
   out.row.confidence = filtered.confidence;
   out.row.samples = static_cast<int>(out.samples.size());
+  out.row.sunlit_samples = out.fit.sunlit_samples;
+  out.row.shadowed_samples = out.fit.shadowed_samples;
+  out.row.sun_up = out.fit.sun_up;
   return out;
 }
 

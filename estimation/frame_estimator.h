@@ -35,6 +35,10 @@ struct FrameEstimate {
   SunSky light;                    // filtered E_sun, E_sky (radiance units, exposure divided out)
   double confidence = 0.0;
   int samples = 0;
+  // The fit's strata (not in the CSV): samples the sun reaches well, samples in shadow, and
+  // whether the sun was up. Sun up with no sunlit sample: E_sun not observed (the estimate holds).
+  int sunlit_samples = 0, shadowed_samples = 0;
+  bool sun_up = false;
   bool decoded = true;             // false: the frame could not be decoded (the estimate holds)
 
   // False until the first usable fit: the light is all zero before it.

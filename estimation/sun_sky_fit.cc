@@ -281,7 +281,7 @@ double ShareFactor(const SunSkyFitOptions& options, double share) { return std::
 double Confidence(const SunSkyFitOptions& options, const SunSkyFitSummary& summary, bool with_sun) {
   const double fit_quality = std::exp(-std::pow(summary.residual_spread / options.confident_residual, 2.0));
   const double strata = std::min(1.0, static_cast<double>(summary.shadowed_samples) / options.min_stratum_samples) *
-                        (with_sun ? std::min(1.0, static_cast<double>(summary.sunlit_samples) / options.min_stratum_samples) : 1.0);
+                        (summary.sun_up ? std::min(1.0, static_cast<double>(summary.sunlit_samples) / options.min_stratum_samples) : 1.0);
   const double s = summary.sun_share_sunlit, s0 = options.absent_sun_share;
   const double at_s0 = ShareFactor(options, s0);
   const double sun_split = !with_sun ? 1.0 : s >= s0 ? ShareFactor(options, s) : 1.0 - (1.0 - at_s0) * s / s0;
@@ -303,6 +303,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   for (size_t i = 0; i < samples.size(); ++i) {
     const Sample& s = samples[i];
     if (glm::compMax(s.sky) > 0.0f || glm::compMax(s.sun) > 0.0f) usable.push_back(i);
+    summary.sun_up = summary.sun_up || glm::compMax(s.sun) > 0.0f;
     if (IsSunlit(s, options)) {
       ++summary.sunlit_samples;
     } else if (!s.sunlit) {
@@ -349,8 +350,10 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   summary.status = unconverged_channels > 0 ? SunSkyFitStatus::kNoConvergence
                    : with_sun                ? SunSkyFitStatus::kConverged
                                              : SunSkyFitStatus::kSkyOnly;
-  summary.message = fmt::format("{} samples ({} sunlit, {} shadowed), residual spread {:.3f}{}", n,
-                                summary.sunlit_samples, summary.shadowed_samples, summary.residual_spread,
+  summary.message = fmt::format("{} samples ({} sunlit, {} shadowed{}), residual spread {:.3f}{}", n,
+                                summary.sunlit_samples, summary.shadowed_samples,
+                                summary.sun_up && !with_sun ? ": the sun is up but reaches none, E_sun not observed" : "",
+                                summary.residual_spread,
                                 unconverged_channels > 0
                                     ? fmt::format("; {} of 3 channels still moving after {} iterations",
                                                   unconverged_channels, options.iterations)

@@ -72,6 +72,10 @@ struct SunSkyFitSummary {
   double residual_spread = 0.0; // 1.4826·median |relative residual| over channels (robust σ)
   int sunlit_samples = 0;
   int shadowed_samples = 0;
+  // Some sample's sun term is > 0 (the sun is above the horizon and lights something, if only by
+  // reflection). Sun up without sunlit samples: E_sun is not observed, the fit reports 0 with
+  // confidence 0, and the temporal filter holds the last estimate that had it.
+  bool sun_up = false;
   double inlier_share = 0.0;    // samples with |relative residual| < 3·cauchy_scale
   // How well the sun/sky split is posed, from the fitted light (worst channel): the share of the
   // sunlit samples' predicted light that is direct sun, and of the shadowed samples' that is sky

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
+#include <string>
+#include <vector>
 
 #include <glm/gtc/constants.hpp>
 
@@ -167,6 +170,48 @@ TEST(SunSkyFitTest, AnIllPosedSplitLowersTheConfidence) {
   ExpectNear(reflected.light, kClear, 1e-3);
   EXPECT_LT(reflected.sky_share_shadowed, 0.3);
   EXPECT_LT(reflected.confidence, 0.6);
+}
+
+TEST(SunSkyFitTest, AnEmptyStratumIsSaidAndHasNoConfidence) {
+  // Everything in shade while the sun is up (its light reaches the samples by reflection only):
+  // E_sun is not observed. No NaN, the sky still fitted, the confidence 0 so the filter holds.
+  std::mt19937 rng(9);
+  std::vector<Sample> shade = MakeSamples(kClear, 3000, rng);
+  for (Sample& s : shade) {
+    s.sunlit = false;
+    s.sun = 0.1f * s.sky;
+    for (int c = 0; c < 3; ++c) {
+      s.radiance[c] = static_cast<float>(s.albedo[c] / glm::pi<double>() *
+                                         (s.sun[c] * kClear.sun_rgb[c] + s.sky[c] * kClear.sky_rgb[c]));
+    }
+  }
+  const SunSkyFitSummary in_shade = FitSunSky({}, shade);
+  EXPECT_TRUE(in_shade.sun_up);
+  EXPECT_EQ(in_shade.sunlit_samples, 0);
+  EXPECT_EQ(in_shade.status, SunSkyFitStatus::kSkyOnly);
+  EXPECT_EQ(in_shade.confidence, 0.0);
+  EXPECT_NE(in_shade.message.find("E_sun not observed"), std::string::npos) << in_shade.message;
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_TRUE(std::isfinite(in_shade.light.sky_rgb[c]));
+    EXPECT_EQ(in_shade.light.sun_rgb[c], 0.0);
+  }
+  // Everything sunlit: no shadowed stratum to pin E_sky; finite, confidence 0.
+  std::mt19937 rng_lit(9);
+  std::vector<Sample> lit = MakeSamples(kClear, 3000, rng_lit);
+  std::erase_if(lit, [](const Sample& s) { return !s.sunlit; });
+  const SunSkyFitSummary all_lit = FitSunSky({}, lit);
+  EXPECT_EQ(all_lit.shadowed_samples, 0);
+  EXPECT_EQ(all_lit.confidence, 0.0);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_TRUE(std::isfinite(all_lit.light.sun_rgb[c]) && std::isfinite(all_lit.light.sky_rgb[c]));
+  }
+  // The sun below the horizon is not an empty stratum: no sun term anywhere, full confidence.
+  std::mt19937 rng_night(9);
+  std::vector<Sample> night = MakeSamples({{0, 0, 0}, {1.2, 1.5, 2.1}}, 2000, rng_night);
+  for (Sample& s : night) s.sun = glm::vec3(0.0f), s.sunlit = false;
+  const SunSkyFitSummary dark = FitSunSky({}, night);
+  EXPECT_FALSE(dark.sun_up);
+  EXPECT_GT(dark.confidence, 0.9);
 }
 
 TEST(SunSkyFitTest, SunBelowTheHorizonFitsTheSkyAlone) {

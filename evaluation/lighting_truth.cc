@@ -119,12 +119,15 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
     r.first_frame = frames[b.begin].frame, r.last_frame = frames[b.end - 1].frame;
     r.sun_elevation_deg = frames[b.begin].sun_elevation_deg;
     std::array<std::vector<double>, 3> sun, sky, sun_error, sky_error;
-    std::vector<double> confidence;
+    std::vector<double> confidence, sunlit, shadowed;
     r.min_confidence = 1.0;
     for (size_t i = b.begin; i < b.end; ++i) {
       const estimation::FrameEstimate& f = frames[i];
       if (!f.decoded) continue;
       confidence.push_back(f.confidence);
+      sunlit.push_back(f.sunlit_samples), shadowed.push_back(f.shadowed_samples);
+      r.frames_without_sunlit += f.sun_up && f.sunlit_samples == 0 ? 1 : 0;
+      r.frames_without_shadowed += f.shadowed_samples == 0 ? 1 : 0;
       r.min_confidence = std::min(r.min_confidence, f.confidence);
       for (size_t k = 0; k < 3; ++k) {
         sun[k].push_back(f.light.sun_rgb[static_cast<int>(k)]), sky[k].push_back(f.light.sky_rgb[static_cast<int>(k)]);
@@ -136,6 +139,7 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
       }
     }
     r.confidence = Median(confidence);
+    if (!sunlit.empty()) r.sunlit_samples = static_cast<int>(Median(sunlit)), r.shadowed_samples = static_cast<int>(Median(shadowed));
     r.has_truth = truth != nullptr;
     for (int c = 0; c < 3; ++c) {
       const size_t k = static_cast<size_t>(c);
@@ -150,12 +154,14 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
 std::string BurstsCsv(const std::vector<BurstLighting>& bursts) {
   const bool truth = !bursts.empty() && bursts[0].has_truth;
   std::string csv = "burst,first_frame,last_frame,frames,sun_elevation_deg,sun_r,sun_g,sun_b,sky_r,sky_g,sky_b,confidence,"
-                    "min_confidence";
+                    "min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,frames_without_shadowed";
   csv += truth ? ",sun_error_r,sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b\n" : "\n";
   for (const BurstLighting& b : bursts) {
     csv += fmt::format("{},{},{},{},{:.3f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{:.4f}", b.burst.index,
                        b.first_frame, b.last_frame, b.burst.end - b.burst.begin, b.sun_elevation_deg, b.sun.x, b.sun.y,
                        b.sun.z, b.sky.x, b.sky.y, b.sky.z, b.confidence, b.min_confidence);
+    csv += fmt::format(",{},{},{},{}", b.sunlit_samples, b.shadowed_samples, b.frames_without_sunlit,
+                       b.frames_without_shadowed);
     if (truth) {
       csv += fmt::format(",{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f}", b.sun_error.x, b.sun_error.y, b.sun_error.z,
                          b.sky_error.x, b.sky_error.y, b.sky_error.z);
@@ -235,9 +241,25 @@ void ReportBursts(const std::vector<BurstLighting>& bursts, const std::filesyste
     const std::string key = fmt::format("lighting/burst/{}/", b.burst.index);
     report->Figure(key + "confidence", b.confidence);
     report->Figure(key + "sun_elevation_deg", b.sun_elevation_deg);
+    report->Figure(key + "frames_without_sunlit", b.frames_without_sunlit);
+    report->Figure(key + "frames_without_shadowed", b.frames_without_shadowed);
     for (int c = 0; truth && c < 3; ++c) {
       report->Figure(key + "sun_error/" + std::string(1, "rgb"[c]), b.sun_error[c]);
       report->Figure(key + "sky_error/" + std::string(1, "rgb"[c]), b.sky_error[c]);
+    }
+  }
+  for (const BurstLighting& b : bursts) {
+    const int frames = static_cast<int>(b.burst.end - b.burst.begin);
+    if (b.frames_without_sunlit > 0) {
+      report->Say(fmt::format("  burst {}: no sunlit sample in {} of {} frames while the sun was up: E_sun is not observed "
+                              "there (fit confidence 0): the estimate holds the last fit that saw the sun, or the burst's "
+                              "first fit, with E_sun = 0, if none did",
+                              b.burst.index, b.frames_without_sunlit, frames));
+    }
+    if (b.frames_without_shadowed > 0) {
+      report->Say(fmt::format("  burst {}: no shadowed sample in {} of {} frames: E_sun and E_sky are told apart by "
+                              "the sunlit samples alone (fit confidence 0): the estimate holds the last fit that had both",
+                              b.burst.index, b.frames_without_shadowed, frames));
     }
   }
   report->Figure("lighting/bursts", static_cast<double>(bursts.size()));

@@ -62,12 +62,18 @@ struct BurstLighting {
   glm::dvec3 sun{0.0}, sky{0.0};   // median estimates
   double confidence = 0.0;         // median
   double min_confidence = 0.0;
+  // The fit's strata over the burst's decoded frames: median sample counts, and the frames where
+  // one was empty (no sunlit sample while the sun was up: E_sun not observed; no shadowed one:
+  // E_sky rests on the sunlit samples alone). Both lower the confidence.
+  int sunlit_samples = 0, shadowed_samples = 0;
+  int frames_without_sunlit = 0, frames_without_shadowed = 0;
   bool has_truth = false;
   glm::dvec3 sun_error{NAN}, sky_error{NAN};
 };
 std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEstimate>& frames, const TruthComparison* truth);
 // bursts.csv: burst,first_frame,last_frame,frames,sun_elevation_deg,sun_r,sun_g,sun_b,sky_r,sky_g,
-// sky_b,confidence,min_confidence[,sun_error_r,...,sky_error_b with truth].
+// sky_b,confidence,min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,
+// frames_without_shadowed[,sun_error_r,...,sky_error_b with truth].
 std::string BurstsCsv(const std::vector<BurstLighting>& bursts);
 
 // Estimate vs truth over time, per channel: a PNG with a sun panel and a sky panel.

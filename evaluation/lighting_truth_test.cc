@@ -16,6 +16,8 @@ estimation::FrameEstimate Frame(int index, double seconds, double sun_r, double 
   f.light.sun_rgb = glm::dvec3(sun_r, 10.0, 10.0);
   f.light.sky_rgb = glm::dvec3(sky_r, 2.0, 2.0);
   f.confidence = 0.5 + 0.01 * index;
+  f.sunlit_samples = 100 + index, f.shadowed_samples = 200 + index;
+  f.sun_up = true;
   return f;
 }
 
@@ -38,7 +40,10 @@ TEST(LightingTruthTest, BurstsAreFramesLessThanTwoSecondsApart) {
 }
 
 TEST(LightingTruthTest, EachBurstHasItsOwnMedianErrors) {
-  const std::vector<estimation::FrameEstimate> frames = Frames();
+  std::vector<estimation::FrameEstimate> frames = Frames();
+  frames[4].sunlit_samples = 0;    // burst 1: one frame with the sun up and nothing sunlit,
+  frames[3].shadowed_samples = 0;  // one with nothing in shade
+  frames[5].sunlit_samples = 0, frames[5].sun_up = false;  // and one with the sun down: not empty
   TruthComparison truth;
   for (size_t i = 0; i < frames.size(); ++i) truth.truth.push_back({glm::dvec3(10.0), glm::dvec3(2.0)});
   truth.truth[1].sun_rgb = glm::dvec3(0.0);  // no sun there: left out of E_sun's errors
@@ -55,10 +60,17 @@ TEST(LightingTruthTest, EachBurstHasItsOwnMedianErrors) {
   EXPECT_EQ(bursts[1].last_frame, 5);
   EXPECT_NEAR(bursts[1].confidence, 0.54, 1e-12);
   EXPECT_NEAR(bursts[1].min_confidence, 0.53, 1e-12);
+  EXPECT_EQ(bursts[1].frames_without_sunlit, 1);
+  EXPECT_EQ(bursts[1].frames_without_shadowed, 1);
+  EXPECT_EQ(bursts[0].frames_without_sunlit + bursts[0].frames_without_shadowed, 0);
+  EXPECT_EQ(bursts[0].sunlit_samples, 101);  // median of 100, 101, 102
+  EXPECT_EQ(bursts[1].sunlit_samples, 0);    // of 0, 0, 103: the upper of the middle
   const std::string csv = BurstsCsv(bursts);
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "burst,first_frame,last_frame,frames,sun_elevation_deg,sun_r,sun_g,sun_b,sky_r,sky_g,sky_b,confidence,"
-            "min_confidence,sun_error_r,sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b");
+            "min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,frames_without_shadowed,sun_error_r,"
+            "sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b");
+  EXPECT_NE(csv.find(",0,204,1,1,"), std::string::npos) << csv;  // burst 1: medians 0 and 204, one empty each
   // Without truth: the estimates only.
   EXPECT_FALSE(CompareBursts(frames, nullptr)[0].has_truth);
   EXPECT_TRUE(std::isnan(CompareBursts(frames, nullptr)[0].sun_error.x));

@@ -4,7 +4,9 @@
 // the bake, sun from the ephemeris, sampler with transfer terms, fit, temporal filter.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "bake/bake.h"
@@ -91,6 +93,43 @@ TEST(EstimateRecordingTest, CourtyardCEveryBurstWithin5Percent) {
   // issue's 0.9: burst 1's clear frames (E_sky red just over 10%) are as well posed as burst 3's
   // (within 5%); what sets them apart is the arcade wall's albedo, which no per-frame figure sees.
   ExpectPerBurst(testing::CourtyardC(), {{1, 0.05, 0.10}}, 0.10, 0.75);
+}
+
+TEST(EstimateRecordingTest, EveryDiffuseSurfaceInShadeIsSaidNotNaN) {
+  // courtyard-c with only the arcade's back wall and its roof's underside marked diffuse: in shade
+  // in every frame while the sun is up. E_sun is not observed: every frame says so, with
+  // confidence 0 and no NaN, and the report names the bursts.
+  const testing::BundledCourtyard& c = testing::CourtyardC();
+  bake::SceneBake shade = c.bake;
+  const int wall = c.scene.model.SurfaceIndex("building_arcade"), roof = c.scene.model.SurfaceIndex("arcade_roof");
+  ASSERT_GE(wall, 0);
+  ASSERT_GE(roof, 0);
+  for (size_t i = 0; i < shade.camera.diffuse.size(); ++i) {
+    const uint32_t s = shade.camera.surface[i];
+    if (s != static_cast<uint32_t>(wall) && s != static_cast<uint32_t>(roof)) shade.camera.diffuse[i] = 0;
+  }
+  const scene::RayCaster caster(c.scene.model);
+  pipeline::LightingPipeline lighting(c.scene, shade, caster, {});
+  const pipeline::PipelineRun run = lighting.Run(scene::OpenFrameSource(c.scene));
+  ASSERT_EQ(run.frames.size(), 500u);
+  for (const estimation::FrameEstimate& f : run.frames) {
+    EXPECT_TRUE(f.sun_up) << f.frame;
+    EXPECT_EQ(f.sunlit_samples, 0) << f.frame;
+    EXPECT_GT(f.shadowed_samples, 1000) << f.frame;
+    for (int ch = 0; ch < 3; ++ch) {
+      EXPECT_TRUE(std::isfinite(f.light.sun_rgb[ch]) && std::isfinite(f.light.sky_rgb[ch])) << f.frame;
+    }
+    EXPECT_TRUE(std::isfinite(f.confidence)) << f.frame;
+    EXPECT_LE(f.confidence, 1e-9) << f.frame;
+  }
+  const std::vector<evaluation::BurstLighting> bursts = evaluation::CompareBursts(run.frames, nullptr);
+  ASSERT_EQ(bursts.size(), 5u);
+  for (const evaluation::BurstLighting& b : bursts) {
+    EXPECT_EQ(b.frames_without_sunlit, static_cast<int>(b.burst.end - b.burst.begin)) << b.burst.index;
+    EXPECT_EQ(b.frames_without_shadowed, 0) << b.burst.index;
+  }
+  const std::string csv = evaluation::BurstsCsv(bursts);
+  EXPECT_NE(csv.find("frames_without_sunlit"), std::string::npos);
 }
 
 }  // namespace
