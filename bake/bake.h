@@ -78,7 +78,8 @@ struct SceneBake {
 };
 
 // The cache key: inputs that change the bake (scene.json, model, env map, diffuse mask, the
-// frames the detail comes from, options, format), hashed (FNV-1a 64, hex).
+// frames the detail comes from, options, format, and the SHA-256 of the code that bakes, made
+// at build time), hashed (FNV-1a 64, hex).
 std::string BakeHash(const scene::Scene& scene, const BakeOptions& options);
 
 // Computes the whole bake, with a progress bar. Throws InputError for an env map that is not 2:1 or

@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 
 #include "bake/bake.h"
+#include "bake/bake_code_hash.h"  // generated: DAYLIT_BAKE_CODE_HASH (bake/CMakeLists.txt)
 #include "bake/sampling.h"
 #include "base/atomic_file.h"
 #include "base/csv.h"
@@ -116,6 +117,7 @@ glm::vec3 Vec(const nlohmann::json& j) { return {j[0].get<float>(), j[1].get<flo
 std::string BakeHash(const scene::Scene& scene, const BakeOptions& options) {
   Fnv1a h;
   h.Add(kBakeFormat);
+  h.Add(DAYLIT_BAKE_CODE_HASH);  // another build's code: another bake
   h.Add(options.Describe());
   h.AddFile(scene.file);
   h.AddFile(scene.model.file);

@@ -200,6 +200,7 @@ class PacedSource final : public FrameSource {
   FrameStatus Next(Frame* frame) override {
     const FrameStatus status = source_->Next(frame);
     stats_ = source_->stats();
+    stats_.scheduled_s = scheduled_s_;
     if (status != FrameStatus::kFrame && status != FrameStatus::kUndecodable) return status;
     const auto now = std::chrono::steady_clock::now();
     // A gap of more than kMaxGap between two frames (a time-lapse's bursts hours apart) is not
@@ -208,9 +209,12 @@ class PacedSource final : public FrameSource {
     previous_ = frame->utc;
     if (!first_ || gap) {
       first_ = frame->utc, start_ = now;
+      done_s_ = scheduled_s_;
       return status;
     }
     const double seconds = frame->utc.SecondsSince(*first_) / speed_;
+    scheduled_s_ = done_s_ + seconds;
+    stats_.scheduled_s = scheduled_s_;
     std::this_thread::sleep_until(start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                std::chrono::duration<double>(seconds)));
     return status;
@@ -228,6 +232,8 @@ class PacedSource final : public FrameSource {
   double speed_;
   std::optional<UtcTime> first_, previous_;
   std::chrono::steady_clock::time_point start_;
+  double scheduled_s_ = 0.0;  // the schedule so far
+  double done_s_ = 0.0;       // of which the stretches before the current one
 };
 
 }  // namespace

@@ -23,21 +23,33 @@ function(daylit_add_library)
   daylit_apply_flags(${ARG_NAME})
 endfunction()
 
-# daylit_add_test(NAME x_test SRCS x_test.cc LINK_LIBS ... [ENVIRONMENT VAR=value ...]): one
-# GoogleTest binary whose tests are registered with ctest under "<folder>/<name>" so
-# `ctest -R sunmodel/` runs one module.
+# daylit_add_test(NAME x_test SRCS x_test.cc LINK_LIBS ... [ENVIRONMENT VAR=value]
+#                 [FIXTURES fixture]): one GoogleTest binary whose tests are registered with
+# ctest under "<folder>/<name>" so `ctest -R sunmodel/` runs one module. Its main()
+# (base/test_main.cc) keeps HOME, the XDG folders and TMPDIR inside the build tree. FIXTURES: the
+# CTest fixture its tests need (courtyard_bakes, the bundled recordings' bakes: tests/).
 function(daylit_add_test)
   if(NOT DAYLIT_BUILD_TESTS)
     return()
   endif()
-  cmake_parse_arguments(ARG "" "NAME" "SRCS;LINK_LIBS;ENVIRONMENT" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME;ENVIRONMENT;FIXTURES" "SRCS;LINK_LIBS" ${ARGN})
   file(RELATIVE_PATH folder ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR})
   add_executable(${ARG_NAME} ${ARG_SRCS})
-  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LINK_LIBS} GTest::gtest GTest::gtest_main)
+  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LINK_LIBS} daylit_test_main)
   target_compile_definitions(${ARG_NAME} PRIVATE
     DAYLIT_SOURCE_DIR="${PROJECT_SOURCE_DIR}" DAYLIT_BINARY_DIR="${PROJECT_BINARY_DIR}")
   daylit_apply_flags(${ARG_NAME})
+  set(properties)
+  if(ARG_ENVIRONMENT)
+    list(APPEND properties ENVIRONMENT "${ARG_ENVIRONMENT}")
+  endif()
+  if(ARG_FIXTURES)
+    list(APPEND properties FIXTURES_REQUIRED "${ARG_FIXTURES}")
+  endif()
+  # (gtest_discover_tests flattens PROPERTIES: one value per property, no lists.)
+  if(properties)
+    set(properties PROPERTIES ${properties})
+  endif()
   gtest_discover_tests(${ARG_NAME} TEST_PREFIX "${folder}/${ARG_NAME}." DISCOVERY_TIMEOUT 60
-                       WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
-                       PROPERTIES ENVIRONMENT "${ARG_ENVIRONMENT}")
+                       WORKING_DIRECTORY ${PROJECT_SOURCE_DIR} ${properties})
 endfunction()
