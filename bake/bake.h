@@ -100,8 +100,13 @@ void SaveBake(const SceneBake& bake, const scene::Scene& scene, const BakeOption
 // Loads a bake from `dir` if its bake.json carries `hash`; nullopt when missing or stale.
 std::optional<SceneBake> LoadBake(const std::filesystem::path& dir, const std::string& hash);
 
-// `dir` unless empty, else $XDG_CACHE_HOME/daylit/<scene name> (~/.cache/daylit/<name>).
+// `dir` unless empty, else $XDG_CACHE_HOME/daylit/<folder> (~/.cache/daylit/<folder>), where
+// <folder> is CacheFolderName(scene name).
 std::filesystem::path CacheDir(const scene::Scene& scene, const std::filesystem::path& dir);
+// A scene name as one folder name: characters other than letters, digits, '-', '_' and '.' become
+// '_', at most 100 of them, and a name of dots only (or none) gets "unnamed" in front. Never a
+// path: "../../x" is ".._.._x", "/etc" is "_etc".
+std::string CacheFolderName(const std::string& scene_name);
 
 // The cached bake when its hash matches, else a new one (saved). `loaded` tells which.
 SceneBake BakeOrLoad(const scene::Scene& scene, const BakeOptions& options, const std::filesystem::path& dir,

@@ -137,6 +137,20 @@ std::string AlbedoCsv(const std::vector<SurfaceAlbedo>& table) {
   return out;
 }
 
+std::string CacheFolderName(const std::string& scene_name) {
+  // A name never becomes a path: separators, "..", a leading "/", control and other characters
+  // are replaced, so the folder is always one level under the cache root.
+  std::string out;
+  for (const char c : scene_name) {
+    const bool safe = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
+                      c == '_' || c == '.';
+    out += safe ? c : '_';
+  }
+  if (out.size() > 100) out.resize(100);
+  if (out.find_first_not_of('.') == std::string::npos) out = "unnamed" + out;  // "", ".", ".."
+  return out;
+}
+
 fs::path CacheDir(const scene::Scene& scene, const fs::path& dir) {
   if (!dir.empty()) return dir;
   const char* xdg = std::getenv("XDG_CACHE_HOME");
@@ -144,7 +158,7 @@ fs::path CacheDir(const scene::Scene& scene, const fs::path& dir) {
   const fs::path base = xdg != nullptr && *xdg != '\0' ? fs::path(xdg)
                         : home != nullptr && *home != '\0' ? fs::path(home) / ".cache"
                                                             : fs::temp_directory_path();
-  return base / "daylit" / scene.name;
+  return base / "daylit" / CacheFolderName(scene.name);
 }
 
 void SaveBake(const SceneBake& bake, const scene::Scene& scene, const BakeOptions& options, const fs::path& dir) {

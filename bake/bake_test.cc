@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <string>
 
 #include "bake/synthetic_recording.h"
 #include "base/error.h"
@@ -169,6 +171,24 @@ std::string BakeErrorOf(SyntheticRecording& rec, int env_height = 0) {
     return e.what();
   }
   return "no error";
+}
+
+TEST(BakeTest, ASceneNameNeverBecomesAPath) {
+  for (const std::string name : {"../../escaped", "/etc/cron.d", "", ".", "..", "a/b\\c", "x\ny", "courtyard-a"}) {
+    const std::string folder = CacheFolderName(name);
+    EXPECT_FALSE(folder.empty()) << name;
+    EXPECT_EQ(folder.find('/'), std::string::npos) << name;
+    EXPECT_NE(folder, ".");
+    EXPECT_NE(folder, "..");
+    EXPECT_EQ(std::filesystem::path(folder).filename().string(), folder) << name;
+    scene::Scene scene;
+    scene.name = name;
+    EXPECT_EQ(CacheDir(scene, {}).parent_path().filename(), "daylit") << name;
+  }
+  EXPECT_EQ(CacheFolderName("courtyard-a"), "courtyard-a");
+  EXPECT_EQ(CacheFolderName("../../escaped"), ".._.._escaped");
+  EXPECT_EQ(CacheFolderName(".."), "unnamed..");
+  EXPECT_EQ(CacheFolderName(std::string(300, 'a')).size(), 100u);
 }
 
 TEST(BakeTest, BadInputsAreNamed) {

@@ -36,13 +36,23 @@ struct WallScene {
   }
   glm::vec3 Capture() const { return glm::vec3(scene.envmap->position); }
 
+  // Whether the sun reaches point p, worked out by hand rather than with the sampler's ray
+  // casting (so that its shadow errors show): the wall is the plane x = 1, |y| ≤ 10, 0 ≤ z ≤ 3,
+  // the sun along (1, 0, 1)/√2. A ground point's ray toward it meets x = 1 at height 1 − x, so
+  // it is shadowed for −2 ≤ x < 1 and |y| ≤ 10; the wall's own faces: the one facing +x is lit.
+  static bool SunReaches(const glm::vec3& p, const glm::vec3& normal) {
+    if (glm::dot(normal, glm::vec3(1.0f, 0.0f, 1.0f)) <= 0.0f) return false;
+    if (std::abs(p.z) > 1e-3f) return true;  // on the wall, facing the sun
+    return !(p.x >= -2.0f && p.x < 1.0f && std::abs(p.y) <= 10.0f);
+  }
+
   // The frame the model predicts for `light`, as linear RGB floats times `exposure`.
-  cv::Mat Render(const Sampler& sampler, const SunSky& light, double exposure) const {
+  cv::Mat Render(const SunSky& light, double exposure) const {
     const bake::CameraGBuffer& g = bake.camera;
     cv::Mat frame(g.height, g.width, CV_32FC3, cv::Scalar(0, 0, 0));
     for (size_t i = 0; i < g.surface.size(); ++i) {
       if (g.surface[i] == bake::kNoSurface) continue;
-      const float a = sampler.sunlit()[i] ? std::max(0.0f, glm::dot(g.normal[i], sun)) : 0.0f;
+      const float a = SunReaches(g.point[i], g.normal[i]) ? std::max(0.0f, glm::dot(g.normal[i], sun)) : 0.0f;
       // Seed 001's model: a uniform sky without interreflection (lighting_model.h).
       const Transfer t{glm::vec3(a), glm::vec3(g.sky_visibility[i]), glm::vec3(g.sky_visibility[i])};
       const glm::dvec3 l = exposure * glm::dvec3(g.albedo[i] * glm::one_over_pi<float>() * Irradiance(SplitLight(light, 0.0), t));
@@ -60,7 +70,7 @@ TEST(SamplerTest, ExactSyntheticFrameIsRecoveredTo0_1Percent) {
   EXPECT_EQ(sampler.StratumCount(), 2u);  // ground sunlit, ground shadowed
   const SunSky light{{86.0, 63.0, 37.0}, {9.9, 9.7, 10.0}};
   const double exposure = 0.004;  // keeps sunlit ground (0.4/π·(86·0.71 + 9.9) ≈ 9) below clipping
-  const std::vector<Sample> samples = sampler.Draw(w.Render(sampler, light, exposure), exposure);
+  const std::vector<Sample> samples = sampler.Draw(w.Render(light, exposure), exposure);
   EXPECT_GT(samples.size(), 1500u);  // of 3072 pixels, less the shadow-edge and silhouette margins
   const SunSkyFitSummary fit = FitSunSky({}, samples);
   ASSERT_EQ(fit.status, SunSkyFitStatus::kConverged) << fit.message;
@@ -75,7 +85,7 @@ TEST(SamplerTest, AnEncodedFrameIsLinearisedWhereRead) {
   Sampler sampler(w.bake, w.Capture(), *w.caster, WallScene::SeedModel());
   sampler.SetSun(w.sun);
   const SunSky light{{86.0, 63.0, 37.0}, {9.9, 9.7, 10.0}};
-  const cv::Mat linear = w.Render(sampler, light, 0.004);
+  const cv::Mat linear = w.Render(light, 0.004);
   const capture::CameraResponse srgb;
   cv::Mat encoded = linear.clone();
   for (auto it = encoded.begin<cv::Vec3f>(); it != encoded.end<cv::Vec3f>(); ++it) {
@@ -109,7 +119,7 @@ TEST(SamplerTest, ShadowEdgesClippedAndDarkPixelsAreLeftOut) {
   EXPECT_GT(at_wall, 48u * 4u);
   // Clipped and black pixels are skipped.
   const SunSky light{{86.0, 63.0, 37.0}, {9.9, 9.7, 10.0}};
-  cv::Mat frame = w.Render(sampler, light, 0.004);
+  cv::Mat frame = w.Render(light, 0.004);
   const size_t all = sampler.Draw(frame, 0.004).size();
   frame.setTo(cv::Scalar(1.0f, 1.0f, 1.0f), cv::Mat(frame.size(), CV_8UC1, cv::Scalar(0)));
   cv::Mat clipped = frame.clone();
@@ -134,7 +144,7 @@ TEST(SamplerTest, SunVisibilityIsRecastOnlyForAnotherSun) {
   EXPECT_TRUE(sampler.SetSun(glm::vec3(0.0f, 0.0f, -1.0f)));
   EXPECT_EQ(sampler.StratumCount(), 1u);
   const SunSky night{{0, 0, 0}, {0.5, 0.6, 0.9}};
-  const std::vector<Sample> samples = sampler.Draw(w.Render(sampler, night, 0.1), 0.1);
+  const std::vector<Sample> samples = sampler.Draw(w.Render(night, 0.1), 0.1);
   const SunSkyFitSummary fit = FitSunSky({}, samples);
   EXPECT_EQ(fit.status, SunSkyFitStatus::kSkyOnly);
   EXPECT_NEAR(fit.light.sky_rgb.z, 0.9, 0.9e-3);

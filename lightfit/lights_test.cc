@@ -48,9 +48,10 @@ TEST(MedianCutTest, AnyNumberOfLightsKeepsThePowerAndExtendsTheLevels) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(power5[c], power8[c], 1e-6 * power8[c]);
 }
 
-TEST(MedianCutTest, ReproducesSeed002sErrorsOnGalileo) {
+TEST(MedianCutTest, Seed002sMaxErrorOnGalileoAndOurMean) {
   // Seed 002, Fig. 2 caption: median cut with 8 lights on Galileo's tomb, about 25% mean and over
-  // 75% max per-normal relative error; more lights, less error.
+  // 75% max per-normal relative error; more lights, less error. The max is reproduced; the mean
+  // is half the seed's (docs/lightfit.md says why), so it is held to what we measure.
   const HdrImage map = scene::ReadHdrImage(DAYLIT_SOURCE_DIR "/probes/galileo_latlong_1024x512.hdr");
   const std::vector<glm::vec3> normals = sh::IcosahedronNormals(5);
   const std::vector<glm::dvec3> truth = sh::ExactIrradiance(map, normals);
@@ -60,10 +61,8 @@ TEST(MedianCutTest, ReproducesSeed002sErrorsOnGalileo) {
     std::printf("median cut, %d lights: mean %.1f%%, max %.1f%% over %zu normals\n", 1 << levels, 100 * e.mean,
                 100 * e.max, e.normals);
     if (levels == 3) {
-      // Measured 12.3% mean, 86.8% max: the max as the seed's, the mean half of its ~25%
-      // (docs/lightfit.md discusses why).
-      EXPECT_GT(e.mean, 0.08);
-      EXPECT_LT(e.mean, 0.30);
+      // Measured 12.3% mean, 86.8% max.
+      EXPECT_NEAR(e.mean, 0.123, 0.01);
       EXPECT_GT(e.max, 0.75);
     }
     EXPECT_LT(e.mean, previous);

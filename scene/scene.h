@@ -116,6 +116,9 @@ SceneSun SunAt(const Scene& scene, const UtcTime& utc);
 // Loads `path` (a scene.json, or a recording folder holding one), the OBJ model it names and
 // its frames.csv, and checks every field. Throws InputError "<file>: <field>: <problem>".
 Scene LoadScene(const std::filesystem::path& path);
+// Paths in scene.json that leave its folder (absolute ones, or "../x") are refused (InputError
+// naming the field) unless this is set (daylit --allow-outside-paths). Process-wide.
+void AllowPathsOutsideRecording(bool allow);
 
 // The scene's frames as a FrameSource: its video or image sequence with frames.csv (exposures
 // falling back to camera.exposure), or its live device.

@@ -17,15 +17,30 @@ namespace fs = std::filesystem;
 // Tolerance on |RᵀR − I| for a rotation typed with ~9 significant digits.
 constexpr double kRotationTolerance = 1e-5;
 
-fs::path Resolve(const Scene& scene, const std::string& relative) {
+bool allow_paths_outside = false;
+
+// The path `field` names (`relative`: its text, or a pattern made from it), against the
+// recording folder. One that leaves the folder (absolute, or climbing out with "..") is refused
+// unless AllowPathsOutsideRecording(true): a recording made by someone else must not make daylit
+// read /etc/passwd. The check is lexical; symbolic links inside the folder are followed.
+fs::path Resolve(const Scene& scene, const JsonField& field, const std::string& relative) {
   const fs::path p(relative);
-  return p.is_absolute() ? p : scene.folder / p;
+  const fs::path path = p.is_absolute() ? p : scene.folder / p;
+  if (!allow_paths_outside) {
+    const fs::path inside = p.lexically_normal();
+    const bool leaves = p.is_absolute() || inside.empty() || *inside.begin() == "..";
+    if (leaves) {
+      field.Fail(fmt::format("'{}' is outside the recording folder {} (daylit --allow-outside-paths allows it)",
+                             relative, scene.folder.string()));
+    }
+  }
+  return path;
 }
 
 // The path a field names, which must exist as a regular file.
 fs::path RequireFile(const Scene& scene, const JsonField& field) {
   const std::string relative = field.String();
-  const fs::path path = Resolve(scene, relative);
+  const fs::path path = Resolve(scene, field, relative);
   if (!fs::is_regular_file(path)) field.Fail(fmt::format("file '{}' not found", path.string()));
   return path;
 }
@@ -232,7 +247,7 @@ void LoadFrames(const JsonField& root, Scene* scene) {
     if (!IsFramePattern(pattern)) {
       images.Fail(fmt::format("'{}' must contain exactly one %d or %0Nd (e.g. frames/%06d.png)", pattern));
     }
-    spec.image_pattern = Resolve(*scene, pattern).string();
+    spec.image_pattern = Resolve(*scene, images, pattern).string();
     if (!fs::is_regular_file(spec.ImagePath(0))) {
       images.Fail(fmt::format("frame 0 ('{}') not found", spec.ImagePath(0).string()));
     }
@@ -350,7 +365,7 @@ void LoadGroundTruth(const JsonField& root, Scene* scene) {
   gt->WarnUnknownKeys({"lighting", "composites"});
   if (auto lighting = gt->Find("lighting")) scene->groundtruth.lighting = RequireFile(*scene, *lighting);
   if (auto composites = gt->Find("composites")) {
-    const fs::path folder = Resolve(*scene, composites->String());
+    const fs::path folder = Resolve(*scene, *composites, composites->String());
     if (!fs::is_directory(folder)) composites->Fail(fmt::format("folder '{}' not found", folder.string()));
     scene->groundtruth.composites = folder;
   }
@@ -410,6 +425,8 @@ double VirtualObject::BoundingRadius() const {
   }
   return s;
 }
+
+void AllowPathsOutsideRecording(bool allow) { allow_paths_outside = allow; }
 
 Scene LoadScene(const fs::path& path) {
   Scene scene;

@@ -42,10 +42,16 @@ TEST(SceneLoaderTest, LoadsTheBundledRecordingCompletely) {
   EXPECT_FALSE(scene.volume->defaulted);
   EXPECT_EQ(scene.volume->resolution, glm::ivec3(10, 8, 4));
   EXPECT_TRUE(scene.groundtruth.lighting.has_value());
-  // The camera stands about 6.8 m from the origin, above the ground, looking down at it.
+  // The pose as scene.json writes it (world_to_camera R, t), worked out by hand: the centre
+  // −Rᵀt = (1.2, 6.5, 1.75) m, and the principal ray, R's third row (0.0415, −0.9861, −0.1609),
+  // meets the ground z = 0 at (1.65, −4.23) m, 10.9 m along it.
   const glm::dvec3 center = scene.Camera().CenterInWorld();
-  EXPECT_GT(center.z, 1.0);
-  EXPECT_GT(scene.Camera().UnprojectToWorldRay({479.5, 269.5}).z, -1.0);
+  EXPECT_NEAR(glm::distance(center, glm::dvec3(1.2, 6.5, 1.75)), 0.0, 1e-6);
+  const glm::dvec3 ray = glm::normalize(scene.Camera().UnprojectToWorldRay({479.5, 269.5}));
+  EXPECT_NEAR(glm::distance(ray, glm::dvec3(0.041519865, -0.986098647, -0.160889864)), 0.0, 1e-6);
+  const glm::dvec3 ground = center + (-center.z / ray.z) * ray;
+  EXPECT_NEAR(ground.x, 1.65, 0.01);
+  EXPECT_NEAR(ground.y, -4.23, 0.01);
 }
 
 TEST(SceneLoaderTest, DefaultsFillOmittedFields) {
@@ -211,6 +217,10 @@ const BadScene kBadScenes[] = {
        s.WriteText("oob.obj", "o ground\nv 0 0 0\nv 1 1 0\nv 1 0 0\nf 1 2 9\n");
        j["model"]["file"] = "oob.obj";
      }, "oob.obj: Vertex indices out of bounds"},
+    {"model path outside the folder", [](auto& j, auto&) { j["model"]["file"] = "/etc/passwd"; },
+     "model.file: '/etc/passwd' is outside the recording folder"},
+    {"video path climbing out", [](auto& j, auto&) { j["frames"]["video"] = "frames/../../x/video.mp4"; },
+     "frames.video: 'frames/../../x/video.mp4' is outside the recording folder"},
     {"frames.csv without zone", [](auto& j, const SceneSandbox& s) {
        s.WriteText("frames_bad.csv", "frame,time_utc\n0,2026-06-21T05:00:00\n");
        j["frames"]["timestamps"] = "frames_bad.csv";
@@ -225,6 +235,20 @@ INSTANTIATE_TEST_SUITE_P(Table, SceneLoaderBadInputTest, ::testing::ValuesIn(kBa
                            }
                            return name;
                          });
+
+TEST(SceneLoaderTest, PathsOutsideTheFolderOnlyWhenAllowed) {
+  // The same file named by an absolute path: refused, then followed with the option (daylit
+  // --allow-outside-paths); a path that goes down and back up again stays inside.
+  SceneSandbox sandbox("outside");
+  sandbox.json()["model"]["file"] = (sandbox.dir() / "model.obj").string();
+  const std::filesystem::path file = sandbox.Write();
+  EXPECT_THROW(LoadScene(file), InputError);
+  AllowPathsOutsideRecording(true);
+  EXPECT_NO_THROW(LoadScene(file));
+  AllowPathsOutsideRecording(false);
+  sandbox.json()["model"]["file"] = "groundtruth/../model.obj";
+  EXPECT_NO_THROW(LoadScene(sandbox.Write()));
+}
 
 TEST(SceneLoaderTest, MalformedJsonNamesLineAndColumn) {
   SceneSandbox sandbox("malformed");

@@ -8,6 +8,7 @@
 #include "base/check.h"
 #include "base/error.h"
 #include "base/log.h"
+#include "scene/scene.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"daylit: estimate sun and sky light from a camera and light virtual objects with it"};
@@ -15,6 +16,8 @@ int main(int argc, char** argv) {
   int verbosity = 1;
   app.add_flag_callback("-q,--quiet", [&] { verbosity = 0; }, "Only warnings and errors on stderr");
   app.add_flag_callback("-v,--verbose", [&] { verbosity = 2; }, "Debug output on stderr");
+  app.add_flag_callback("--allow-outside-paths", [] { daylit::scene::AllowPathsOutsideRecording(true); },
+                        "Follow paths in scene.json that leave the recording's folder (refused by default)");
   app.parse_complete_callback([&] { daylit::SetLogVerbosity(verbosity); });
   daylit::app::AddSunposCommand(app);
   daylit::app::AddInfoCommand(app);
