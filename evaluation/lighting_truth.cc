@@ -100,6 +100,11 @@ ConfidenceRanking RankByConfidence(const std::vector<double>& confidence, const 
   return r;
 }
 
+std::filesystem::path BurstsCsvPath(const std::filesystem::path& csv) {
+  if (csv.filename() == "estimates.csv") return csv.parent_path() / "bursts.csv";
+  return csv.parent_path() / (csv.stem().string() + "_bursts.csv");
+}
+
 std::vector<Burst> SplitBursts(const std::vector<estimation::FrameEstimate>& frames, double gap_s) {
   std::vector<Burst> bursts;
   for (size_t i = 0; i < frames.size(); ++i) {
@@ -216,10 +221,6 @@ void PlotEstimates(const std::vector<estimation::FrameEstimate>& frames, const T
 
 namespace {
 
-std::filesystem::path BurstsCsvPath(const std::filesystem::path& csv) {
-  if (csv.filename() == "estimates.csv") return csv.parent_path() / "bursts.csv";
-  return csv.parent_path() / (csv.stem().string() + "_bursts.csv");
-}
 
 // The per-burst table as report lines and figures (lighting/burst/<k>/...), and bursts.csv.
 void ReportBursts(const std::vector<BurstLighting>& bursts, const std::filesystem::path& csv, RunReport* report) {

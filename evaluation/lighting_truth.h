@@ -76,6 +76,10 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
 // frames_without_shadowed[,sun_error_r,...,sky_error_b with truth].
 std::string BurstsCsv(const std::vector<BurstLighting>& bursts);
 
+// Where the bursts' table goes beside the estimates' CSV `csv`: bursts.csv beside estimates.csv,
+// else <stem>_bursts.csv.
+std::filesystem::path BurstsCsvPath(const std::filesystem::path& csv);
+
 // Estimate vs truth over time, per channel: a PNG with a sun panel and a sky panel.
 void PlotEstimates(const std::vector<estimation::FrameEstimate>& frames, const TruthComparison* truth,
                    const std::string& title, const std::filesystem::path& png);

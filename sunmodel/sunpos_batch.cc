@@ -73,6 +73,7 @@ RowInput ParseRow(const CsvTable& table, size_t row, const Columns& c) {
   }
   in.orientation.delta_t_s = OptionalNumber(table, row, c.delta_t, "delta_t_s");
   in.orientation.dut1_s = OptionalNumber(table, row, c.dut1, "dut1_s");
+  if (const std::string why = in.orientation.Check(); !why.empty()) ThrowInputError("{}: {}", table.Where(row), why);
   return in;
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "base/utc_time.h"
@@ -13,6 +14,9 @@ namespace daylit::sunmodel {
 struct EarthOrientation {
   std::optional<double> delta_t_s;  // TT − UT1 in seconds
   std::optional<double> dut1_s;     // UT1 − UTC in seconds; absent means 0
+  // Empty when plausible, else the problem naming the field: |dut1| < 0.9 s (the IERS keeps UTC
+  // so), ΔT finite within [−1000, 20000] s (about −500 to 3000 CE by Morrison & Stephenson).
+  std::string Check() const;
 };
 
 enum class DeltaTSource {

@@ -697,6 +697,15 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"relight " + kRecording + " --like-frame 5 --sky up --out " + dir + "/r.mp4", "--sky: 'up' is not keep or follow"},
       {"relight " + kRecording + " --like-frame 5 --e-sun 1,2 --out " + dir + "/r.mp4", "--e-sun: give R,G,B (2 values given)"},
       {"relight " + kRecording + " --like-frame 5 --out " + dir + "/r.avi", "--out: " + dir + "/r.avi must end in .mp4 or .mkv"},
+      // Two outputs of one run with one name, refused before any work (issue 21).
+      {"estimate " + kRecording + " --out " + dir + "/y.csv --plot " + dir + "/y.csv",
+       "--out and --plot (or the --out's .png) both name " + dir + "/y.csv"},
+      {"estimate " + kRecording + " --out " + dir + "/x.png", "--out and --plot (or the --out's .png) both name " + dir + "/x.png"},
+      {"sunpos --scene " + kRecording + " --frames --out " + dir + "/s.png --plot " + dir + "/s.png",
+       "--out and --plot both name " + dir + "/s.png"},
+      {"relight-env " + kRecording + " --frame 0 --out " + dir + "/e.png", "--out: " + dir + "/e.png must end in .exr"},
+      {"sunpos --time 2026-06-21T10:00:00Z --lat 50 --lon 10 --dut1 5", "--dut1: 5 s is not UT1 − UTC"},
+      {"sunpos --time 2026-06-21T10:00:00Z --lat 50 --lon 10 --delta-t 1e300", "--delta-t: 1e+300 s is outside [-1000, 20000]"},
   };
   for (const BadCall& call : calls) {
     const CliRun run = Daylit(call.args);  // NOLINT

@@ -3,7 +3,10 @@
 #pragma once
 
 #include <atomic>
+#include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -22,6 +25,11 @@ void AddReplayCommand(CLI::App& app);
 void AddRelightCommand(CLI::App& app);
 void AddLiveCommand(CLI::App& app);
 void AddResultsCommand(CLI::App& app);
+
+// Throws InputError when two of a run's outputs (option or what it names, path) are one file,
+// before any work: `estimate --out y.csv --plot y.csv` would write the plot over the table.
+// Empty paths (an output not asked for) are skipped.
+void RefuseSharedOutputs(const std::vector<std::pair<std::string, std::filesystem::path>>& outputs);
 
 // --lighting volume|lights:N, for the commands that render the objects (render::ParseLighting).
 void AddLightingOption(CLI::App* cmd, std::string* lighting);

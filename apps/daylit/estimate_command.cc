@@ -36,6 +36,9 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   if (!o.figures.empty() && std::filesystem::path(o.figures).extension() != ".json") {
     ThrowInputError("--figures: {} must end in .json", o.figures);
   }
+  const std::string plot = o.plot.empty() ? std::filesystem::path(o.out).replace_extension(".png").string() : o.plot;
+  RefuseSharedOutputs({{"--out", o.out}, {"--plot (or the --out's .png)", plot},
+                       {"the bursts' table", evaluation::BurstsCsvPath(o.out)}, {"--figures", o.figures}});
   const scene::Scene scene = scene::LoadScene(o.recording);
   // The frames first: a camera that is not there is an error now, not after the bake.
   std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
@@ -55,7 +58,6 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   const size_t n = run.frames.size();
   double moves_ms = 0.0;
   for (const double ms : run.sun_moves_ms) moves_ms += ms;
-  const std::string plot = o.plot.empty() ? std::filesystem::path(o.out).replace_extension(".png").string() : o.plot;
   evaluation::RunReport report;
   evaluation::RunFigures(run, &report);
   evaluation::ReportLighting(scene, run.frames, o.out, plot, &report);

@@ -25,6 +25,9 @@ struct RelightEnvOptions {
 };
 
 void RunRelightEnv(const RelightEnvOptions& o) {
+  if (std::filesystem::path(o.out).extension() != ".exr") {
+    ThrowInputError("--out: {} must end in .exr (its preview is written beside it as .png)", o.out);
+  }
   const scene::Scene scene = scene::LoadScene(o.recording);
   if (!scene.envmap) ThrowInputError("{}: envmap: needed to relight it", scene.file.string());
   const size_t position = scene::FramePosition(scene, o.frame, "--frame");
