@@ -26,6 +26,12 @@ void CheckEnvMap(const HdrImage& image, const std::string& name);
 
 // The value half of CheckEnvMap, for images of any shape.
 void CheckRadianceValues(const HdrImage& image, const std::string& name);
+// A light probe (env map or angular map) at least kMinProbeWidth texels wide and half as high,
+// and with some light in it (a texel > 0): InputError naming the file otherwise.
+inline constexpr int kMinProbeWidth = 64;
+// (`width` × `height`: a latitude-longitude map's; a square angular map passes its side twice.)
+void CheckLightProbeSize(int width, int height, const std::string& name);
+void CheckSomeLight(const HdrImage& image, const std::string& name);
 
 enum class ExrPixelType { kHalf, kFloat, kUint };
 

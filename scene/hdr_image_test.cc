@@ -17,6 +17,25 @@ std::filesystem::path Temp(const std::string& name) {
   return std::filesystem::temp_directory_path() / ("daylit_hdr_" + std::to_string(::getpid()) + "_" + name);
 }
 
+TEST(HdrImageTest, TinyOrBlackEnvMapsAreRefusedByName) {
+  // A 2x1 map passes for 2:1; an all-black one has no light: both would give E = 0 and NaN errors.
+  const auto message = [](const HdrImage& image) {
+    try {
+      CheckEnvMap(image, "env.exr");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(message(HdrImage{2, 1, std::vector<float>(6, 1.0f)}),
+            "env.exr: 2x1 is too small for a light probe (at least 64 texels across: each under 6°)");
+  EXPECT_EQ(message(HdrImage{128, 64, std::vector<float>(128 * 64 * 3, 0.0f)}),
+            "env.exr: every texel is black: a light probe with no light (estimates would be 0 and errors NaN)");
+  std::vector<float> one_light(128 * 64 * 3, 0.0f);
+  one_light[777] = 0.5f;
+  EXPECT_EQ(message(HdrImage{128, 64, one_light}), "");
+}
+
 TEST(HdrImageTest, ReadsTheBundledEnvMapAsFloats) {
   const HdrImage env = ReadHdrImage(DAYLIT_SOURCE_DIR "/recordings/courtyard-a/envmap.exr");
   ASSERT_EQ(env.width, 1024);
@@ -48,7 +67,7 @@ TEST(HdrImageTest, MultiChannelExrRoundTripsFloatHalfAndUint) {
 }
 
 TEST(HdrImageTest, EnvMapChecksNameTheCause) {
-  HdrImage image{8, 4, std::vector<float>(8 * 4 * 3, 1.0f)};
+  HdrImage image{64, 32, std::vector<float>(64 * 32 * 3, 1.0f)};
   EXPECT_NO_THROW(CheckEnvMap(image, "e.exr"));
   image.Pixel(3, 2)[1] = NAN;
   image.Pixel(5, 2)[0] = -1.0f;

@@ -13,11 +13,39 @@
 namespace daylit::scene {
 namespace {
 
+// A face line ("f 1 2/5 -3//4 ..."): at least 3 vertices, each index an integer that names a
+// vertex defined so far when negative (relative, as OBJ says) and is not 0. tinyobjloader drops
+// shorter faces and mis-resolves such indices without a word.
+void CheckFaceLine(const std::filesystem::path& path, int line, std::string_view l, size_t vertices_so_far) {
+  int count = 0;
+  while (true) {
+    while (!l.empty() && (l.front() == ' ' || l.front() == '\t' || l.front() == '\r')) l.remove_prefix(1);
+    if (l.empty() || l.front() == '#') break;
+    size_t n = 0;
+    while (n < l.size() && l[n] != ' ' && l[n] != '\t' && l[n] != '\r') ++n;
+    const std::string_view token = l.substr(0, n), index_text = token.substr(0, token.find('/'));
+    long long index = 0;
+    const auto [ptr, ec] = std::from_chars(index_text.data(), index_text.data() + index_text.size(), index);
+    if (index_text.empty() || ec != std::errc() || ptr != index_text.data() + index_text.size() || index == 0) {
+      ThrowInputError("{}:{}: face vertex '{}' is not a vertex index (1-based, or negative from the last)",
+                      path.string(), line, token);
+    }
+    if (index < 0 && static_cast<size_t>(-index) > vertices_so_far) {
+      ThrowInputError("{}:{}: face vertex {} reaches before the first vertex ({} defined so far)", path.string(),
+                      line, index, vertices_so_far);
+    }
+    ++count;
+    l.remove_prefix(n);
+  }
+  if (count < 3) ThrowInputError("{}:{}: a face needs at least 3 vertices, this one has {}", path.string(), line, count);
+}
+
 // tinyobjloader reads "nan" and "inf" as 0 without a word, so vertex lines are checked here
-// first, with their line numbers.
+// first, with their line numbers; and face lines (CheckFaceLine).
 void CheckVertexLines(const std::filesystem::path& path, std::string_view text) {
   size_t pos = 0;
   int line = 0;
+  size_t vertices = 0;
   while (pos < text.size()) {
     size_t end = text.find('\n', pos);
     if (end == std::string_view::npos) end = text.size();
@@ -25,7 +53,12 @@ void CheckVertexLines(const std::filesystem::path& path, std::string_view text) 
     pos = end + 1;
     ++line;
     while (!l.empty() && (l.front() == ' ' || l.front() == '\t')) l.remove_prefix(1);
+    if (l.size() >= 2 && l[0] == 'f' && (l[1] == ' ' || l[1] == '\t')) {
+      CheckFaceLine(path, line, l.substr(2), vertices);
+      continue;
+    }
     if (l.size() < 2 || l[0] != 'v' || (l[1] != ' ' && l[1] != '\t')) continue;
+    ++vertices;
     l.remove_prefix(2);
     for (int k = 0; k < 3; ++k) {
       while (!l.empty() && (l.front() == ' ' || l.front() == '\t')) l.remove_prefix(1);

@@ -40,6 +40,17 @@ TEST(ModelTest, QuadsAreTriangulatedAndNamesMerged) {
   EXPECT_NEAR(model.SurfaceAreas()[0], 1.0 + 0.5, 1e-6);
 }
 
+TEST(ModelTest, NegativeIndicesCountBackFromTheLastVertex) {
+  // OBJ's relative indices: -1 is the last vertex defined so far. Texture and normal indices
+  // after '/' are carried by the reader and not used.
+  const auto path = std::filesystem::temp_directory_path() / ("daylit_model_neg_" + std::to_string(::getpid()) + ".obj");
+  WriteFileAtomically(path, "o a\nv 0 0 0\nv 2 0 0\nv 0 2 0\nvt 0 0\nf -3/1 -2/1 -1/1\nv 9 9 9\n");
+  const SceneModel model = LoadObjModel(path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(model.triangles.size(), 1u);
+  EXPECT_NEAR(model.SurfaceAreas()[0], 2.0, 1e-6);  // the first three vertices, not the fourth
+}
+
 TEST(ModelTest, BadModelsAreInputErrors) {
   const auto path = std::filesystem::temp_directory_path() / ("daylit_bad_" + std::to_string(::getpid()) + ".obj");
   for (const char* text : {"o a\nv 0 0 0\nv inf 1 0\nv 1 1 0\nf 1 2 3\n", "o a\nv 0 0\nf 1 1 1\n",

@@ -217,6 +217,18 @@ const BadScene kBadScenes[] = {
        s.WriteText("oob.obj", "o ground\nv 0 0 0\nv 1 1 0\nv 1 0 0\nf 1 2 9\n");
        j["model"]["file"] = "oob.obj";
      }, "oob.obj: Vertex indices out of bounds"},
+    {"OBJ face of two vertices", [](auto& j, const SceneSandbox& s) {
+       s.WriteText("two.obj", "o ground\nv 0 0 0\nv 1 1 0\nv 1 0 0\nf 1 2 3\nf 1 2\n");
+       j["model"]["file"] = "two.obj";
+     }, "two.obj:6: a face needs at least 3 vertices, this one has 2"},
+    {"OBJ negative index before the start", [](auto& j, const SceneSandbox& s) {
+       s.WriteText("neg.obj", "o ground\nv 0 0 0\nv 1 1 0\nf -1 -2 -3\nv 1 0 0\n");
+       j["model"]["file"] = "neg.obj";
+     }, "neg.obj:4: face vertex -3 reaches before the first vertex (2 defined so far)"},
+    {"OBJ index 0", [](auto& j, const SceneSandbox& s) {
+       s.WriteText("zero.obj", "o ground\nv 0 0 0\nv 1 1 0\nv 1 0 0\nf 0/1 1/2 2/3\n");
+       j["model"]["file"] = "zero.obj";
+     }, "zero.obj:5: face vertex '0/1' is not a vertex index"},
     {"model path outside the folder", [](auto& j, auto&) { j["model"]["file"] = "/etc/passwd"; },
      "model.file: '/etc/passwd' is outside the recording folder"},
     {"video path climbing out", [](auto& j, auto&) { j["frames"]["video"] = "frames/../../x/video.mp4"; },
