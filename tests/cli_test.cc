@@ -323,6 +323,13 @@ TEST(CliTest, CalibrateResponseWritesATableTheSceneCanName) {
   // Gamma 2.2: code 128 is 0.22 of code 255.
   EXPECT_NEAR(table->linear[1][128], std::pow(128.0 / 255.0, 2.2), 0.03);
   EXPECT_TRUE(fs::is_regular_file(dir / "response.png"));
+  // One image twice, at two times: the curve is undetermined; refused, nothing written.
+  const fs::path same = dir / "bracket0.png";
+  const CliRun twice = Daylit("calibrate-response " + same.string() + " " + same.string() + " --times 1,2 --out " +
+                              (dir / "same.csv").string());
+  EXPECT_EQ(twice.exit_code, 2);
+  EXPECT_NE(twice.err.find("every image of the bracket is the same"), std::string::npos) << twice.err;
+  EXPECT_FALSE(fs::exists(dir / "same.csv"));
   fs::remove_all(dir);
 }
 
@@ -665,8 +672,10 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"lights " + kProbe + " --threshold 5 --out " + dir + "/l", "--threshold: 5 is not a mean relative error in (0, 1)"},
       {"lights " + dir + "/broken.json --out " + dir + "/l", "broken.json"},
       {"calibrate-response " + kProbe + " " + kProbe + " --times 1", "--times: 1 exposure times for 2 images"},
+      {"calibrate-response " + kProbe + " " + kProbe + " --times 1,1", "have the same exposure time 1 s"},
       {"calibrate-response " + dir + "/none.png " + dir + "/none.png --times 1,2", "none.png: no such file"},
       {"calibrate-camera " + dir + "/broken.json --board 9by6", "--board: '9by6' is not COLSxROWS"},
+      {"calibrate-camera " + dir + "/broken.json --board 99999x99999", "--board: 99999x99999 inner corners; at most 100 a side"},
       {"calibrate-camera " + dir + "/broken.json", "broken.json: cannot be decoded as an image"},
       {"record --device /dev/video-daylit-absent --scene " + kRecording + " --out " + dir + "/rec",
        "/dev/video-daylit-absent: cannot open (No such file or directory); is the camera plugged in?"},

@@ -1,5 +1,7 @@
 // daylit calibrate-response and calibrate-camera: a camera's response curve from an exposure
 // bracket, its intrinsics from chessboard views (docs/capture.md).
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -7,6 +9,7 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "apps/daylit/commands.h"
@@ -39,6 +42,16 @@ void RunCalibrateResponse(const ResponseOptions& o) {
   if (o.seconds.size() != o.images.size()) {
     ThrowInputError("--times: {} exposure times for {} images", o.seconds.size(), o.images.size());
   }
+  // A bracket needs different exposures: equal times or identical images leave the curve
+  // undetermined (the solve gives NaN).
+  for (size_t i = 1; i < o.images.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      if (o.seconds[i] == o.seconds[j]) {
+        ThrowInputError("--times: {} and {} have the same exposure time {} s; a bracket needs different ones",
+                        o.images[j], o.images[i], o.seconds[i]);
+      }
+    }
+  }
   std::vector<cv::Mat> images;
   for (size_t i = 0; i < o.images.size(); ++i) {
     if (!(o.seconds[i] > 0.0f)) ThrowInputError("--times: {} s for {} is not an exposure time", o.seconds[i], o.images[i]);
@@ -48,7 +61,15 @@ void RunCalibrateResponse(const ResponseOptions& o) {
                       o.images[0], images[0].cols, images[0].rows);
     }
   }
+  if (std::all_of(images.begin() + 1, images.end(), [&](const cv::Mat& m) { return cv::norm(m, images[0], cv::NORM_INF) == 0; })) {
+    ThrowInputError("{}: every image of the bracket is the same; the exposures did not change the picture", o.images[0]);
+  }
   capture::ResponseTable table = capture::CalibrateResponse(images, o.seconds);
+  for (size_t c = 0; c < 3; ++c) {
+    for (const double v : table.linear[c]) {
+      if (!std::isfinite(v)) ThrowInputError("{}: the bracket does not determine a response curve (it came out NaN)", o.images[0]);
+    }
+  }
   table.file = o.out;
   capture::WriteResponseTable(o.out, table);
   report::PlotOptions options{"camera response (Debevec & Malik), linear value per 8-bit code", "code", "linear", 900, 420};
@@ -82,6 +103,12 @@ void RunCalibrateCamera(const CameraOptions& o) {
   if (std::sscanf(o.board.c_str(), "%d%c%d", &board.inner_columns, &x, &board.inner_rows) != 3 || x != 'x' ||
       board.inner_columns < 2 || board.inner_rows < 2) {
     ThrowInputError("--board: '{}' is not COLSxROWS of inner corners, e.g. 9x6", o.board);
+  }
+  // OpenCV's corner search allocates per corner and takes minutes on a huge pattern; a printed
+  // board has a few dozen corners a side.
+  constexpr int kMaxCorners = 100;
+  if (board.inner_columns > kMaxCorners || board.inner_rows > kMaxCorners) {
+    ThrowInputError("--board: {} inner corners; at most {} a side", o.board, kMaxCorners);
   }
   if (!(o.square_m > 0.0)) ThrowInputError("--square: {} m is not a square size", o.square_m);
   board.square_m = o.square_m;
