@@ -23,6 +23,14 @@ function(daylit_add_library)
   daylit_apply_flags(${ARG_NAME})
 endfunction()
 
+# The environment every test runs in: home, XDG folders and TMPDIR inside the build tree, so no
+# test reads or writes the user's home or /tmp. Test binaries set it in their main()
+# (base/test_main.cc); the fixture tests that run `daylit` itself get it as a CTest property.
+set(DAYLIT_TEST_HOME ${PROJECT_BINARY_DIR}/test-home)
+set(DAYLIT_TEST_ENVIRONMENT
+    HOME=${DAYLIT_TEST_HOME} XDG_CACHE_HOME=${DAYLIT_TEST_HOME}/cache XDG_CONFIG_HOME=${DAYLIT_TEST_HOME}/config
+    XDG_DATA_HOME=${DAYLIT_TEST_HOME}/share TMPDIR=${PROJECT_BINARY_DIR}/test-tmp)
+
 # daylit_add_test(NAME x_test SRCS x_test.cc LINK_LIBS ... [ENVIRONMENT VAR=value]
 #                 [FIXTURES fixture]): one GoogleTest binary whose tests are registered with
 # ctest under "<folder>/<name>" so `ctest -R sunmodel/` runs one module. Its main()

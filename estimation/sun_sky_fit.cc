@@ -249,14 +249,14 @@ double PooledOvercastShare(ChannelFitter* fitter, const std::vector<size_t>& usa
 void SplitShares(const SunSkyFitOptions& options, const std::vector<Sample>& samples, const std::vector<size_t>& usable,
                  SunSkyFitSummary* summary) {
   glm::dvec3 sun_lit(0.0), all_lit(0.0), sky_shadow(0.0), all_shadow(0.0);
-  const double o = summary->overcast_share;
+  // The model's two parts of each sample's predicted radiance: PredictedRadiance with one term.
+  const SunSky sun_only{summary->light.sun_rgb, glm::dvec3(0.0)}, sky_only{glm::dvec3(0.0), summary->light.sky_rgb};
   for (const size_t i : usable) {
     const Sample& s = samples[i];
     const bool lit = IsSunlit(s, options);
     if (!lit && s.sunlit) continue;  // grazing sun: neither stratum
-    const glm::dvec3 sun = glm::dvec3(s.albedo) * glm::dvec3(s.sun) * summary->light.sun_rgb;
-    const glm::dvec3 sky = glm::dvec3(s.albedo) * ((1.0 - o) * glm::dvec3(s.sky) + o * glm::dvec3(s.overcast)) *
-                           summary->light.sky_rgb;
+    const glm::dvec3 sun(PredictedRadiance(s, sun_only, summary->overcast_share));
+    const glm::dvec3 sky(PredictedRadiance(s, sky_only, summary->overcast_share));
     // Each sample weighs as its share (a mean of shares, not a share of sums: bright points do
     // not outvote dim ones).
     const glm::dvec3 total = glm::max(sun + sky, glm::dvec3(1e-30));

@@ -221,7 +221,6 @@ void PlotEstimates(const std::vector<estimation::FrameEstimate>& frames, const T
 
 namespace {
 
-
 // The per-burst table as report lines and figures (lighting/burst/<k>/...), and bursts.csv.
 void ReportBursts(const std::vector<BurstLighting>& bursts, const std::filesystem::path& csv, RunReport* report) {
   WriteFileAtomically(csv, BurstsCsv(bursts));
@@ -287,13 +286,14 @@ std::optional<TruthComparison> ReportLighting(const scene::Scene& scene, const s
                             100 * truth->p90_worst_channel_error));
     const ConfidenceRanking& rank = truth->ranking;
     if (rank.bad_frames > 0 && rank.good_frames > 0) {
-      report->Say(fmt::format("  confidence ranking: {} frames over 10% against {} within 5%: AUC {:.2f}; {:.0f}% of those "
-                              "frames score below 90% of the good ones",
-                              rank.bad_frames, rank.good_frames, rank.auc, 100 * rank.bad_below_90_percent_of_good));
+      report->Say(fmt::format("  confidence ranking: {} frames over {:g}% against {} within {:g}%: AUC {:.2f}; {:.0f}% of "
+                              "those frames score below 90% of the good ones",
+                              rank.bad_frames, 100 * kBadFrameError, rank.good_frames, 100 * kGoodFrameError, rank.auc,
+                              100 * rank.bad_below_90_percent_of_good));
       report->Figure("lighting/confidence_auc", rank.auc);
     } else {
-      report->Say(fmt::format("  confidence ranking: {} frames over 10%, {} within 5% (no ranking without both)",
-                              rank.bad_frames, rank.good_frames));
+      report->Say(fmt::format("  confidence ranking: {} frames over {:g}%, {} within {:g}% (no ranking without both)",
+                              rank.bad_frames, 100 * kBadFrameError, rank.good_frames, 100 * kGoodFrameError));
     }
     report->Figure("lighting/frames", truth->frames);
     report->Figure("lighting/p90_worst_channel_error", truth->p90_worst_channel_error);

@@ -78,20 +78,17 @@ Probe LoadProbe(const std::filesystem::path& path) {
   Probe probe;
   const HdrImage image = scene::ReadHdrImage(path);
   const std::string name = path.string();
-  if (image.width == image.height) {
-    scene::CheckLightProbeSize(image.width, image.height, name);
-    scene::CheckRadianceValues(image, name);
-    scene::CheckSomeLight(image, name);
-    probe.map = AngularToLatLong(image, 1024, 512);
-    probe.converted_from_angular = true;
-  } else if (image.width == 2 * image.height) {
-    scene::CheckLightProbeSize(image.width, image.height, name);
-    scene::CheckRadianceValues(image, name);
-    scene::CheckSomeLight(image, name);
-    probe.map = image;
-  } else {
+  const bool angular = image.width == image.height;
+  if (!angular && image.width != 2 * image.height) {
     ThrowInputError("{}: {}x{} is neither a 2:1 latitude-longitude map nor a square angular map", name, image.width,
                     image.height);
+  }
+  scene::CheckLightProbe(image, name);
+  if (angular) {
+    probe.map = AngularToLatLong(image, 1024, 512);
+    probe.converted_from_angular = true;
+  } else {
+    probe.map = image;
   }
   if (std::string clipped = ClippedSourceWarning(probe.map); !clipped.empty()) probe.warnings.push_back(name + ": " + clipped);
   return probe;

@@ -7,6 +7,7 @@
 #include <ImfOutputFile.h>
 #include <half.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include <opencv2/imgcodecs.hpp>
@@ -115,23 +116,18 @@ void CheckEnvMap(const HdrImage& image, const std::string& name) {
   if (image.width != 2 * image.height) {
     ThrowInputError("{}: {}x{} is not a 2:1 latitude-longitude map", name, image.width, image.height);
   }
-  CheckLightProbeSize(image.width, image.height, name);
+  CheckLightProbe(image, name);
+}
+
+void CheckLightProbe(const HdrImage& image, const std::string& name) {
+  if (image.width < kMinProbeWidth || image.height < kMinProbeWidth / 2) {
+    ThrowInputError("{}: {}x{} is too small for a light probe (at least {} texels across: each under 6°)", name,
+                    image.width, image.height, kMinProbeWidth);
+  }
   CheckRadianceValues(image, name);
-  CheckSomeLight(image, name);
-}
-
-void CheckLightProbeSize(int width, int height, const std::string& name) {
-  if (width < kMinProbeWidth || height < kMinProbeWidth / 2) {
-    ThrowInputError("{}: {}x{} is too small for a light probe (at least {} texels across: each under 6°)", name, width,
-                    height, kMinProbeWidth);
+  if (std::none_of(image.rgb.begin(), image.rgb.end(), [](float v) { return v > 0.0f; })) {
+    ThrowInputError("{}: every texel is black: a light probe with no light (estimates would be 0 and errors NaN)", name);
   }
-}
-
-void CheckSomeLight(const HdrImage& image, const std::string& name) {
-  for (const float v : image.rgb) {
-    if (v > 0.0f) return;
-  }
-  ThrowInputError("{}: every texel is black: a light probe with no light (estimates would be 0 and errors NaN)", name);
 }
 
 void CheckRadianceValues(const HdrImage& image, const std::string& name) {

@@ -19,19 +19,18 @@ inline float Luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * r
 // .hdr with OpenCV. Throws InputError naming the file when it cannot be read.
 HdrImage ReadHdrImage(const std::filesystem::path& path);
 
-// Checks an environment map: 2:1, every texel finite and ≥ 0. Throws InputError naming the file,
-// the count of bad texels and the first one ("envmap.exr: 12 texels are NaN or infinite, first at
-// (u 40, v 3)").
+// Checks an environment map: 2:1, then CheckLightProbe. Throws InputError naming the file.
 void CheckEnvMap(const HdrImage& image, const std::string& name);
 
-// The value half of CheckEnvMap, for images of any shape.
-void CheckRadianceValues(const HdrImage& image, const std::string& name);
-// A light probe (env map or angular map) at least kMinProbeWidth texels wide and half as high,
-// and with some light in it (a texel > 0): InputError naming the file otherwise.
+// A light probe of either shape (latitude-longitude or square angular map): at least
+// kMinProbeWidth texels wide and half as high, every texel finite and ≥ 0 (else InputError
+// naming the count of bad texels and the first one: "envmap.exr: 12 texels are NaN or infinite,
+// first at (u 40, v 3)"), and some light in it (a texel > 0).
 inline constexpr int kMinProbeWidth = 64;
-// (`width` × `height`: a latitude-longitude map's; a square angular map passes its side twice.)
-void CheckLightProbeSize(int width, int height, const std::string& name);
-void CheckSomeLight(const HdrImage& image, const std::string& name);
+void CheckLightProbe(const HdrImage& image, const std::string& name);
+
+// The value part of CheckLightProbe, for images of any shape.
+void CheckRadianceValues(const HdrImage& image, const std::string& name);
 
 enum class ExrPixelType { kHalf, kFloat, kUint };
 

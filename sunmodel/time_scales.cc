@@ -8,15 +8,16 @@
 
 namespace daylit::sunmodel {
 
-std::string EarthOrientation::Check() const {
+std::string EarthOrientation::Check(std::string_view delta_t_name, std::string_view dut1_name) const {
   if (dut1_s && !(std::abs(*dut1_s) < 0.9)) {
-    return fmt::format("dut1_s: {} s is not UT1 − UTC (|UT1 − UTC| < 0.9 s always)", *dut1_s);
+    return fmt::format("{}: {} s is not UT1 − UTC (|UT1 − UTC| < 0.9 s always)", dut1_name, *dut1_s);
   }
   if (delta_t_s && !(*delta_t_s >= -1000.0 && *delta_t_s <= 20000.0)) {
-    return fmt::format("delta_t_s: {} s is outside [-1000, 20000] (TT − UT1 from 500 BCE to 3000 CE)", *delta_t_s);
+    return fmt::format("{}: {} s is outside [-1000, 20000] (TT − UT1 from 500 BCE to 3000 CE)", delta_t_name, *delta_t_s);
   }
   return {};
 }
+
 namespace {
 
 constexpr double kSecondsPerDay = 86400.0;

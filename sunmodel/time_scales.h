@@ -14,9 +14,10 @@ namespace daylit::sunmodel {
 struct EarthOrientation {
   std::optional<double> delta_t_s;  // TT − UT1 in seconds
   std::optional<double> dut1_s;     // UT1 − UTC in seconds; absent means 0
-  // Empty when plausible, else the problem naming the field: |dut1| < 0.9 s (the IERS keeps UTC
-  // so), ΔT finite within [−1000, 20000] s (about −500 to 3000 CE by Morrison & Stephenson).
-  std::string Check() const;
+  // Empty when plausible, else the problem naming the field as the caller spells it (a CSV
+  // column, a command-line option): |dut1| < 0.9 s (the IERS keeps UTC so), ΔT finite within
+  // [−1000, 20000] s (about −500 to 3000 CE by Morrison & Stephenson).
+  std::string Check(std::string_view delta_t_name = "delta_t_s", std::string_view dut1_name = "dut1_s") const;
 };
 
 enum class DeltaTSource {

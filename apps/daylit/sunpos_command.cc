@@ -190,9 +190,8 @@ void AddSunposCommand(CLI::App& app) {
   frames->needs(scene)->excludes(time);
   cmd->callback([options] {
     const SunposOptions& o = *options;
-    if (const std::string why = sunmodel::EarthOrientation{o.delta_t_s, o.dut1_s}.Check(); !why.empty()) {
-      // The field as the option is spelled: dut1_s is --dut1, delta_t_s is --delta-t.
-      ThrowInputError("{}{}", why.rfind("dut1_s", 0) == 0 ? "--dut1" : "--delta-t", why.substr(why.find(':')));
+    if (const std::string why = sunmodel::EarthOrientation{o.delta_t_s, o.dut1_s}.Check("--delta-t", "--dut1"); !why.empty()) {
+      ThrowInputError("{}", why);
     }
     RefuseSharedOutputs({{"--out", o.out}, {"--plot", o.plot}});
     if (!o.csv_in.empty()) return RunBatch(o);
