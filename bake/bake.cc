@@ -1,4 +1,5 @@
 #include "bake/bake.h"
+#include "bake/parallax.h"
 
 #include <algorithm>
 #include <cmath>
@@ -309,13 +310,10 @@ sh::GatherTables ComputeGatherTables(const scene::Scene& scene, const scene::Ray
   }
   std::vector<scene::RayHit> hits(n);
   caster.IntersectMany(origins.data(), rays.data(), n, 0.0f, hits.data());
-  const glm::dvec3 capture = scene.envmap->position;
+  const glm::vec3 capture(scene.envmap->position);
   gather.texel.resize(n);
-  for (size_t r = 0; r < n; ++r) {
-    // Parallax: the texel that shows the hit point from the capture position; sky straight.
-    const glm::dvec3 toward = hits[r].IsHit() ? glm::dvec3(origins[r] + hits[r].t * rays[r]) - capture : glm::dvec3(rays[r]);
-    gather.texel[r] = static_cast<uint32_t>(LatLongTexel(toward, env.width, env.height));
-  }
+  gather.map_texels = static_cast<size_t>(env.width) * static_cast<size_t>(env.height);
+  for (size_t r = 0; r < n; ++r) gather.texel[r] = ParallaxTexel(origins[r], rays[r], hits[r], capture, env.width, env.height);
   return gather;
 }
 

@@ -21,7 +21,7 @@ namespace daylit::bake {
 
 inline constexpr uint32_t kNoSurface = 0xFFFFFFFFu;  // sky, or no point
 // Bumped whenever the bake computes something differently, so that old caches are re-baked.
-inline constexpr const char* kBakeFormat = "daylit-bake/7";
+inline constexpr const char* kBakeFormat = "daylit-bake/8";
 
 struct BakeOptions {
   RayOptions rays;

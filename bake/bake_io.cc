@@ -1,6 +1,7 @@
 // Storing and loading the bake: the cache key, multi-layer EXRs, bake.json, albedo.csv, previews.
 #include <cstdlib>
 #include <fstream>
+#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
@@ -287,6 +288,19 @@ SceneBake ReadBake(const fs::path& dir, const std::string& hash, const nlohmann:
   if (directions > 0) {
     bake.gather.directions = SphericalFibonacci(directions);
     bake.gather.texel = std::move(scene::ReadExrChannels(dir / "gather.exr", {}, {"texel"}).uints[0]);
+    bake.gather.map_texels = static_cast<size_t>(bake.env.width) * static_cast<size_t>(bake.env.height);
+    // Every entry indexes the env map or its sky layer (bake/parallax.h): a damaged table would
+    // read past them.
+    if (bake.gather.texel.size() != bake.gather.ProbeCount() * bake.gather.directions.size()) {
+      throw std::runtime_error(fmt::format("gather.exr: {} entries for {} probes × {} directions", bake.gather.texel.size(),
+                                           bake.gather.ProbeCount(), bake.gather.directions.size()));
+    }
+    for (const uint32_t t : bake.gather.texel) {
+      if (t >= 2 * bake.gather.map_texels) {
+        throw std::runtime_error(fmt::format("gather.exr: texel {} outside the {}-texel map and its sky layer", t,
+                                             bake.gather.map_texels));
+      }
+    }
   }
   const CsvTable albedo = ReadCsvFile(dir / "albedo.csv");
   for (size_t r = 0; r < albedo.rows.size(); ++r) {

@@ -9,7 +9,9 @@
 #include "bake/synthetic_recording.h"
 #include "base/error.h"
 #include "base/latlong.h"
+#include "scene/hdr_image.h"
 #include "scene/raycaster.h"
+#include "scene/scene.h"
 
 namespace daylit::bake {
 namespace {
@@ -122,19 +124,24 @@ TEST(BakeTest, UniformSkyGivesBackTheGroundAlbedo) {
     ASSERT_NEAR(bake.camera.sky_visibility[i], 1.0f, 0.01f);
     ASSERT_NEAR(bake.camera.albedo[i].y, 0.4f, 0.4f * 0.02f);
   }
-  // Gather tables: 8 probes × 256 directions; sky directions keep their texel, ground directions
-  // take the texel that shows their hit point from the capture position (parallax).
+  // Gather tables: 8 probes × 256 directions; ground directions take the texel that shows their
+  // hit point from the capture position (parallax), sky directions the sky layer's texel in their
+  // direction, after the map's W·H texels (bake/parallax.h).
   ASSERT_EQ(bake.gather.ProbeCount(), 8u);
   const sh::GatherTables& g = bake.gather;
+  const size_t map_texels = static_cast<size_t>(bake.env.width) * static_cast<size_t>(bake.env.height);
+  ASSERT_EQ(g.map_texels, map_texels);
   const glm::vec3 capture(0.0f, 0.0f, 1.5f);
   for (size_t d = 0; d < g.directions.size(); ++d) {
     const glm::vec3 probe = g.ProbePosition(1, 1, 0);  // (1, 1, 0.5)
     const size_t probe_index = (0 * 2 + 1) * 2 + 1;
     const glm::vec3 dir = g.directions[d];
-    glm::dvec3 toward = glm::dvec3(dir);
-    if (dir.z < 0.0f) toward = glm::dvec3(probe + (-probe.z / dir.z) * dir - capture);
-    EXPECT_EQ(g.texel[probe_index * g.directions.size() + d],
-              static_cast<uint32_t>(LatLongTexel(toward, bake.env.width, bake.env.height)));
+    const glm::vec3 ground = probe + (-probe.z / dir.z) * dir;  // the ground ends 100 m out
+    const bool hits = dir.z < 0.0f && std::abs(ground.x) <= 100.0f && std::abs(ground.y) <= 100.0f;
+    const uint32_t want = hits ? static_cast<uint32_t>(LatLongTexel(glm::dvec3(ground - capture), bake.env.width, bake.env.height))
+                                       : static_cast<uint32_t>(map_texels) +
+                                             static_cast<uint32_t>(LatLongTexel(glm::dvec3(dir), bake.env.width, bake.env.height));
+    EXPECT_EQ(g.texel[probe_index * g.directions.size() + d], want);
   }
 }
 
@@ -228,6 +235,28 @@ TEST(BakeTest, BadInputsAreNamed) {
     EXPECT_EQ(scene::RayCaster(scene.model).degenerate_triangles(), 1u);
     EXPECT_NO_THROW(RunBake(scene, BakeOptions{}));
   }
+}
+
+// A cached gather table whose entries reach past the map and its sky layer (a damaged or hostile
+// cache) is not loaded, so the volume never reads outside the map; the bake is then made again.
+TEST(BakeTest, ACachedGatherTableOutsideTheMapIsBakedAgain) {
+  SyntheticRecording rec("gather_cache");
+  const scene::Scene scene = scene::LoadScene(rec.Write());
+  const BakeOptions options;
+  const SceneBake bake = RunBake(scene, options);
+  const std::filesystem::path dir = rec.dir / "cache";
+  SaveBake(bake, scene, options, dir);
+  const std::string hash = BakeHash(scene, options);
+  ASSERT_TRUE(LoadBake(dir, hash).has_value());
+  std::vector<uint32_t> texel = bake.gather.texel;
+  texel[17] = static_cast<uint32_t>(2 * bake.gather.map_texels);  // one past the sky layer's last texel
+  scene::WriteExr(dir / "gather.exr", static_cast<int>(bake.gather.directions.size()), static_cast<int>(bake.gather.ProbeCount()),
+                  {{"texel", scene::ExrPixelType::kUint, nullptr, texel.data()}});
+  EXPECT_FALSE(LoadBake(dir, hash).has_value());
+  texel[17] = static_cast<uint32_t>(2 * bake.gather.map_texels - 1);  // the last one is fine
+  scene::WriteExr(dir / "gather.exr", static_cast<int>(bake.gather.directions.size()), static_cast<int>(bake.gather.ProbeCount()),
+                  {{"texel", scene::ExrPixelType::kUint, nullptr, texel.data()}});
+  EXPECT_TRUE(LoadBake(dir, hash).has_value());
 }
 
 }  // namespace

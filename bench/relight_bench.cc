@@ -43,7 +43,8 @@ void BM_VolumeUpdate512Probes(benchmark::State& state) {
     }
   }
   std::uniform_real_distribution<float> radiance(0.0f, 10.0f);
-  std::vector<glm::vec3> env(1024 * 512);
+  gather.map_texels = 1024 * 512;
+  std::vector<glm::vec3> env(2 * gather.map_texels);  // the map and its sky layer (no direction escapes here)
   for (glm::vec3& l : env) l = glm::vec3(radiance(rng), radiance(rng), radiance(rng));
   sh::IrradianceVolume volume(gather);
   for (auto _ : state) {

@@ -131,17 +131,17 @@ void BM_ObjectShadowsSunMove(benchmark::State& state) {
 BENCHMARK(BM_ObjectShadowsSunMove)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(6);
 
 // --lighting lights:N when the sun moves or the light changes much: the relit map's three parts
-// reprojected to the objects, their exact irradiance at the fit's normals, Irradiance
-// Optimization of the N directions and the per-part linear fit.
+// reprojected to the objects' centre and to each object, their exact irradiance at the fit's
+// normals, Irradiance Optimization of the N directions and the per-part linear fits.
 void BM_FitEnvLights(benchmark::State& state) {
   Courtyard& c = Courtyard::Get();
   relight::EnvRelighter relighter(c.bake, glm::vec3(c.scene.envmap->position), *c.caster);
   relighter.SetSun(c.fit.sun_dir);
   relight::EnvBasis basis;
   relighter.Basis(&basis);
-  glm::vec3 lo, hi;
-  scene::ObjectsModel(c.scene.objects).Bounds(&lo, &hi);
-  lightfit::EnvLights lights(static_cast<int>(state.range(0)), *c.caster, 0.5f * (lo + hi), glm::vec3(c.scene.envmap->position),
+  std::vector<glm::vec3> centres;
+  for (const scene::VirtualObject& o : c.scene.objects) centres.push_back(glm::vec3(o.position));
+  lightfit::EnvLights lights(static_cast<int>(state.range(0)), *c.caster, centres, glm::vec3(c.scene.envmap->position),
                             c.bake.env.width, c.bake.env.height);
   const estimation::LightParts parts = estimation::SplitLight(c.fit.fit.light, c.fit.fit.overcast_share);
   for (auto _ : state) {

@@ -12,6 +12,7 @@
 
 #include <glm/gtc/constants.hpp>
 
+#include "bake/parallax.h"
 #include "bake/sampling.h"
 #include "base/latlong.h"
 
@@ -76,10 +77,10 @@ ObjectShadows::ObjectShadows(const scene::Scene& scene, const bake::SceneBake& b
         if (!toward_object) continue;
         const scene::RayHit object = objects_.Intersect(origin, dir);
         if (!object.IsHit() || real_.Occluded(origin, dir, 0.0f, object.t)) continue;  // none, or a wall in front
-        // What the object hides: the real point behind it, seen from the capture position, or sky.
+        // What the object hides: the real point behind it, seen from the capture position, or the
+        // sky in that direction (bake/parallax.h).
         const scene::RayHit behind = real_.Intersect(origin, dir, object.t);
-        const glm::dvec3 toward = behind.IsHit() ? glm::dvec3(origin + behind.t * dir - capture) : glm::dvec3(dir);
-        texels[i].push_back(static_cast<uint32_t>(LatLongTexel(toward, env_w, env_h)));
+        texels[i].push_back(bake::ParallaxTexel(origin, dir, behind, capture, env_w, env_h));
         sky += behind.IsHit() ? 0 : 1;
       }
       a.sky_lost = static_cast<float>(sky) / static_cast<float>(hemisphere.size());

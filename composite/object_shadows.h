@@ -11,7 +11,8 @@
 // have penumbrae. E_blocked is the light arriving from the directions an object now covers: the
 // sky and the reflecting real surfaces behind it, read from the relit environment map with
 // parallax as the irradiance volume's probes read it (a covered ray's texel is the one showing
-// the real point behind the object from the capture position, or its own direction for sky).
+// the real point behind the object from the capture position, or the sky layer's in its own
+// direction where nothing real is behind it: bake/parallax.h).
 // Without a map it is E_sky times the share of the sky covered. ρ is the bake's camera albedo.
 // Embree rays against the objects' meshes: the covered directions once (the objects do not move),
 // the sun whenever it moves by more than 0.05°.
@@ -72,7 +73,7 @@ class ObjectShadows {
     float cos_sun = 0.0f;    // max(0, n·l)
     bool covers = false;     // an object covers some of the point's hemisphere
     float sky_lost = 0.0f;   // share of the cosine-weighted sky the objects cover
-    uint32_t first = 0, count = 0;  // its covered rays' env texels in covered_texels_
+    uint32_t first = 0, count = 0;  // its covered rays' stacked-map indices in covered_texels_
     float sun_lost = 0.0f;   // s − s': the share of the sun's disc the point sees past the real
                              // model (s) but not past the objects too (s')
     uint32_t neighbours = 0;  // bit (dy + 2)·5 + dx + 2: the 5×5 neighbour is on the frame and the same surface

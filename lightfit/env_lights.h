@@ -14,13 +14,16 @@
 // directions are fitted again.
 //
 // The maps are seen from the capture point; the lights are for the objects, so the maps are
-// first reprojected to the objects' centre (as the volume's gather tables do for each probe): a
-// ray from there per direction, and the texel that shows where it meets the model from the
-// capture point (the sky's texels straight).
-//
-// Each light casts shadows: a light whose direction, seen from the objects, meets the real model
-// stands for light that model reflects, so only the objects shadow it (the wall it comes from
-// must not block it); the others are shadowed by the real model and the objects alike.
+// reprojected (as the volume's gather tables do for each probe): a ray per direction, and the
+// texel that shows where it meets the model from the capture point, or the sky layer's texel in
+// its direction where it escapes (bake/parallax.h). The directions are fitted to the map seen from
+// the objects' common centre; each object then gets its own lights' irradiances, fitted with those
+// directions to the map seen from its own centre. So the real model's occlusion and reflection
+// are in each object's lights, as from where it stands (an object behind a wall gets the wall's
+// light in the wall's direction, one in the open the sky's), and only the objects shadow the
+// lights. Shadowing a light by the real model instead was all or nothing: a light standing for a
+// band of sky just over a wall, seen from the centre, went dark on an object whose own view of that
+// band the wall blocked in part (courtyard-a's box under an overcast sky: 16% dark).
 #pragma once
 
 #include <array>
@@ -40,23 +43,23 @@ class EnvLights {
  public:
   static constexpr int kMaxLights = 16;
 
-  // `n` lights (1..kMaxLights) for the objects around `objects_centre`, from maps of
-  // `env_width` × `env_height` captured at `capture`; `model` is the scene's real model and must
-  // outlive this.
-  EnvLights(int n, const scene::RayCaster& model, const glm::vec3& objects_centre, const glm::vec3& capture,
+  // `n` lights (1..kMaxLights) for objects centred at `object_centres` (at least one), from maps
+  // of `env_width` × `env_height` captured at `capture`; `model` is the scene's real model and
+  // must outlive this.
+  EnvLights(int n, const scene::RayCaster& model, const std::vector<glm::vec3>& object_centres, const glm::vec3& capture,
             int env_width, int env_height);
 
-  // The sun moved: the maps of `basis`, seen from the objects' centre, and their irradiance. The
-  // directions are fitted at the next Update.
+  // The sun moved: the maps of `basis` (stacked on their sky layer), seen from the objects' common
+  // centre and from each object's, and their irradiance. The directions are fitted at the next
+  // Update.
   void SetBasis(const relight::EnvBasis& basis);
 
-  // This frame's lights under `parts`: each part's irradiances weighted by its light (clamped at
-  // 0), the directions fitted again first when needed.
-  const LightSet& Update(const estimation::LightParts& parts);
+  // This frame's lights under `parts`, one set per object (in the order of `object_centres`, the
+  // same directions in each): each part's irradiances weighted by its light (clamped at 0), the
+  // directions fitted again first when needed.
+  const std::vector<LightSet>& Update(const estimation::LightParts& parts);
 
   int count() const { return n_; }
-  // Per light: 1 when it stands for light the real model reflects (only the objects shadow it).
-  const std::vector<uint8_t>& reflected() const { return reflected_; }
   // Bumped whenever the directions change (the shadow maps are then redrawn).
   int generation() const { return generation_; }
   // Of those fits, how many stopped on the iteration limit rather than converging.
@@ -65,26 +68,31 @@ class EnvLights {
   double error() const { return error_; }
 
  private:
+  // The maps as seen from one point, and the lights' irradiances there.
+  struct View {
+    glm::vec3 position{0.0f};
+    std::vector<uint32_t> source;                   // per fit texel, 4 stacked-map indices (2×2 rays)
+    std::array<HdrImage, 3> maps;                   // the parts' maps seen from `position`
+    std::array<std::vector<glm::dvec3>, 3> truth;   // their exact irradiance at normals_
+    std::array<LightSet, 3> parts;                  // per part: ambient and irradiances per unit of its light
+  };
+  View MakeView(const scene::RayCaster& model, const glm::vec3& position, const glm::vec3& capture, int env_width,
+                int env_height) const;
   void FitDirections(const estimation::LightParts& parts);
-  LightSet Combine(const estimation::LightParts& parts) const;
+  void FitIrradiances(const estimation::LightParts& parts, View* view) const;
+  LightSet Combine(const View& view, const estimation::LightParts& parts) const;
   double ErrorOf(const LightSet& lights, const estimation::LightParts& parts) const;
 
   int n_;
-  const scene::RayCaster& model_;
-  glm::vec3 objects_centre_;
-  std::vector<glm::vec3> normals_;            // FitNormals(n)
-  int env_size_ = 0;                          // texels in the captured maps
-  HdrImage layout_;                    // the fit's map size (rgb unused)
-  std::vector<uint32_t> source_;              // per fit texel, 4 captured texels (2×2 rays)
-  std::array<HdrImage, 3> maps_;       // the parts' maps seen from the objects' centre
-  std::array<std::vector<glm::dvec3>, 3> part_truth_;  // their exact irradiance at normals_
-  bool stale_ = true;                         // the basis changed since the directions were fitted
-  double fit_error_ = 0.0;                    // the error just after the last fit
+  std::vector<glm::vec3> normals_;  // FitNormals(n)
+  int env_size_ = 0;                // texels in the captured maps
+  HdrImage layout_;                 // the fit's map size (rgb unused)
+  View centre_;                     // the objects' common centre: the directions, and the error
+  std::vector<View> objects_;       // each object's own centre
+  bool stale_ = true;               // the basis changed since the directions were fitted
+  double fit_error_ = 0.0;          // the error just after the last fit
   std::vector<glm::vec3> directions_;
-  std::vector<uint8_t> reflected_;
-  // Per part (sun, clear, overcast): the ambient and the lights' irradiance per unit of its light.
-  std::array<LightSet, 3> parts_;
-  LightSet current_;
+  std::vector<LightSet> current_;   // per object
   double error_ = 0.0;
   int generation_ = 0;
   int unconverged_fits_ = 0;

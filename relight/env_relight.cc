@@ -18,13 +18,9 @@ EnvRelighter::EnvRelighter(const bake::SceneBake& bake, const glm::vec3& capture
       surface_(bake, estimation::TransferPoints::Env(bake.env), bake.env.width, bake.env.height, true,
                capture_position, caster, options) {
   const bake::EnvMapMaps& env = bake.env;
+  texel_dirs_.reserve(env.surface.size());
   for (int v = 0; v < env.height; ++v) {
-    for (int u = 0; u < env.width; ++u) {
-      const uint32_t t = static_cast<uint32_t>(v) * static_cast<uint32_t>(env.width) + static_cast<uint32_t>(u);
-      if (!env.IsSky(t)) continue;
-      sky_texels_.push_back(t);
-      sky_dirs_.push_back(glm::vec3(LatLongDirection(u, v, env.width, env.height)));
-    }
+    for (int u = 0; u < env.width; ++u) texel_dirs_.push_back(glm::vec3(LatLongDirection(u, v, env.width, env.height)));
   }
 }
 
@@ -32,10 +28,8 @@ bool EnvRelighter::SetSun(const glm::vec3& sun_dir) {
   if (sun_ && *sun_ == sun_dir) return false;  // the caller decides when it moved (scene::SunTracker)
   sun_ = sun_dir;
   surface_.Compute(sun_dir, &terms_);
-  // The sky's shape per sky texel.
-  const std::vector<glm::vec3> shape = surface_.transfer().ClearSkyPerUnitDhi(sun_dir, sky_dirs_);
-  sky_shape_.assign(bake_.env.surface.size(), glm::vec3(0.0f));
-  for (size_t i = 0; i < sky_texels_.size(); ++i) sky_shape_[sky_texels_[i]] = shape[i];
+  // The sky's shape in every texel's direction: the map's sky texels and the sky layer.
+  sky_shape_ = surface_.transfer().ClearSkyPerUnitDhi(sun_dir, texel_dirs_);
   return true;
 }
 
@@ -55,12 +49,22 @@ void EnvRelighter::Relight(const estimation::SunSky& light, double overcast_shar
   }
 }
 
+void EnvRelighter::RelightWithSky(const estimation::SunSky& light, double overcast_share,
+                                  std::vector<glm::vec3>* stacked) const {
+  Relight(light, overcast_share, stacked);
+  const size_t texels = sky_shape_.size();
+  stacked->resize(2 * texels);
+  const LightParts e = SplitLight(light, overcast_share);
+  const glm::vec3 uniform = e.overcast * glm::one_over_pi<float>();
+  for (size_t t = 0; t < texels; ++t) (*stacked)[texels + t] = e.clear * sky_shape_[t] + uniform;
+}
+
 void EnvRelighter::Basis(EnvBasis* basis) const {
   // The map under each light alone, at unit strength.
   const estimation::SunSky sun_only{glm::dvec3(1.0), glm::dvec3(0.0)}, sky_only{glm::dvec3(0.0), glm::dvec3(1.0)};
-  Relight(sun_only, 0.0, &basis->sun);
-  Relight(sky_only, 0.0, &basis->clear);
-  Relight(sky_only, 1.0, &basis->overcast);
+  RelightWithSky(sun_only, 0.0, &basis->sun);
+  RelightWithSky(sky_only, 0.0, &basis->clear);
+  RelightWithSky(sky_only, 1.0, &basis->overcast);
 }
 
 namespace {

@@ -27,8 +27,9 @@
 
 namespace daylit::relight {
 
-// The relit map per unit of each light, per channel: Relight gives
-// E_sun·sun + (1 − o)·E_sky·clear + o·E_sky·overcast, texel by texel.
+// The relit map per unit of each light, per channel, stacked on its sky layer (2·W·H values: the
+// map's texels, then the sky's radiance in each texel's direction; bake/parallax.h):
+// RelightWithSky gives E_sun·sun + (1 − o)·E_sky·clear + o·E_sky·overcast, value by value.
 struct EnvBasis {
   std::vector<glm::vec3> sun, clear, overcast;
 };
@@ -51,7 +52,11 @@ class EnvRelighter {
   // and E_sky, `overcast_share` the share of E_sky from a uniform overcast sky.
   void Relight(const estimation::SunSky& light, double overcast_share, std::vector<glm::vec3>* radiance) const;
 
-  // The three maps Relight combines, for the current sun.
+  // The same followed by the sky layer: 2·W·H values, what parallax lookups read
+  // (bake/parallax.h): the sky alone in each texel's direction, also where the map shows the model.
+  void RelightWithSky(const estimation::SunSky& light, double overcast_share, std::vector<glm::vec3>* stacked) const;
+
+  // The three stacked maps RelightWithSky combines, for the current sun.
   void Basis(EnvBasis* basis) const;
 
   int width() const { return bake_.env.width; }
@@ -61,11 +66,11 @@ class EnvRelighter {
   const bake::SceneBake& bake_;
   SurfaceTerms surface_;
   std::optional<glm::vec3> sun_;
-  std::vector<uint32_t> sky_texels_;      // the texels that show sky, and their directions
-  std::vector<glm::vec3> sky_dirs_;
+  std::vector<glm::vec3> texel_dirs_;  // every texel's direction
   // Per model texel (in surface_.model_points() order): the terms.
   std::vector<estimation::Transfer> terms_;
-  // Per texel: the clear sky's radiance per unit DHI (sky texels only).
+  // Per texel: the clear sky's radiance per unit DHI in its direction (the sky layer's shape; the
+  // map's own where it shows sky).
   std::vector<glm::vec3> sky_shape_;
 };
 

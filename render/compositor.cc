@@ -403,9 +403,23 @@ void Compositor::Render(const CompositeInput& input, float* image) {
   BlendOver(image);
 }
 
+namespace {
+
+// The lights of CompositeInput: as many per object as the options say, one set per object.
+int LightCount(const CompositeInput& input) {
+  if (input.lights == nullptr || input.lights->empty()) return 0;
+  const size_t count = input.lights->front().lights.size();
+  for (const lightfit::LightSet& set : *input.lights) {
+    DAYLIT_CHECK(set.lights.size() == count, "light sets of {} and {} lights", count, set.lights.size());
+  }
+  return static_cast<int>(count);
+}
+
+}  // namespace
+
 // The sun's shadow map, redrawn for another sun (scene::SunTracker says when it moved); the
-// lights' shadow maps, redrawn when their directions change. A light that stands for the real
-// model's reflected light is shadowed by the objects only.
+// lights' shadow maps, redrawn when their directions change, of the objects only (each object's
+// lights already hold what the real model hides or reflects from where it stands).
 void Compositor::UpdateShadowMaps(const CompositeInput& input, const glm::vec3& sun) {
   Gl& g = *gl_;
   if (sun.z > 0.0f && (!g.has_shadow_map || sun != g.shadow_sun)) {
@@ -418,7 +432,7 @@ void Compositor::UpdateShadowMaps(const CompositeInput& input, const glm::vec3& 
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, g.shadow_map.get(), 0);
     DrawShadowMap(g.depth, view, g.options.shadow_map_size, &g.model, g.objects);
   }
-  const int light_count = input.lights != nullptr ? static_cast<int>(input.lights->lights.size()) : 0;
+  const int light_count = LightCount(input);
   DAYLIT_CHECK(light_count == 0 || light_count == g.options.lights, "{} lights given, made for {}", light_count,
                g.options.lights);
   if (light_count == 0 || input.lights_generation == g.light_generation) return;
@@ -428,13 +442,12 @@ void Compositor::UpdateShadowMaps(const CompositeInput& input, const glm::vec3& 
   g.light_texel.resize(static_cast<size_t>(light_count));
   glBindFramebuffer(GL_FRAMEBUFFER, g.shadow.get());
   for (int i = 0; i < light_count; ++i) {
-    const glm::vec3 dir = glm::normalize(input.lights->lights[i].direction);
+    const glm::vec3 dir = glm::normalize(input.lights->front().lights[static_cast<size_t>(i)].direction);
     const ShadowView view = ShadowViewOf(dir, g.objects_lo, g.objects_hi, g.model_lo, g.model_hi, size);
     g.light_shadow_from_world[i] = view.shadow_from_world;
     g.light_texel[i] = view.texel;
-    const bool reflected = input.lights_reflected != nullptr && (*input.lights_reflected)[i] != 0;
     glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, g.light_maps.get(), 0, i);
-    DrawShadowMap(g.depth, view, size, reflected ? nullptr : &g.model, g.objects);
+    DrawShadowMap(g.depth, view, size, nullptr, g.objects);
   }
 }
 
@@ -496,13 +509,13 @@ void Compositor::DrawObjects(const CompositeInput& input, const glm::vec3& sun) 
   glBindTexture(GL_TEXTURE_2D, g.shadow_map.get());
   glUniform1i(program.Uniform("shadow_map"), 1);
   glUniform1i(program.Uniform("has_volume"), input.volume != nullptr ? 1 : 0);
-  const int light_count = input.lights != nullptr ? static_cast<int>(input.lights->lights.size()) : 0;
+  const int light_count = LightCount(input);
   if (light_count > 0) {
-    std::vector<glm::vec3> dirs, rgbs;
-    for (const lightfit::DirectionalLight& l : input.lights->lights) dirs.push_back(glm::normalize(l.direction)), rgbs.push_back(l.irradiance);
-    glUniform3fv(program.Uniform("ambient"), 1, glm::value_ptr(input.lights->ambient));
+    DAYLIT_CHECK(input.lights->size() == g.objects.size(), "light sets for {} objects, not {}", input.lights->size(),
+                 g.objects.size());
+    std::vector<glm::vec3> dirs;
+    for (const lightfit::DirectionalLight& l : input.lights->front().lights) dirs.push_back(glm::normalize(l.direction));
     glUniform3fv(program.Uniform("light_dir"), light_count, glm::value_ptr(dirs[0]));
-    glUniform3fv(program.Uniform("light_rgb"), light_count, glm::value_ptr(rgbs[0]));
     glUniformMatrix4fv(program.Uniform("light_shadow_from_world"), light_count, GL_FALSE,
                        glm::value_ptr(g.light_shadow_from_world[0]));
     glUniform1fv(program.Uniform("light_texel"), light_count, g.light_texel.data());
@@ -510,7 +523,15 @@ void Compositor::DrawObjects(const CompositeInput& input, const glm::vec3& sun) 
     glBindTexture(GL_TEXTURE_2D_ARRAY, g.light_maps.get());
     glUniform1i(program.Uniform("light_maps"), 2);
   }
-  for (const DrawMesh& m : g.objects) {
+  for (size_t o = 0; o < g.objects.size(); ++o) {
+    const DrawMesh& m = g.objects[o];
+    if (light_count > 0) {  // this object's own lights
+      const lightfit::LightSet& own = (*input.lights)[o];
+      std::vector<glm::vec3> rgbs;
+      for (const lightfit::DirectionalLight& l : own.lights) rgbs.push_back(l.irradiance);
+      glUniform3fv(program.Uniform("ambient"), 1, glm::value_ptr(own.ambient));
+      glUniform3fv(program.Uniform("light_rgb"), light_count, glm::value_ptr(rgbs[0]));
+    }
     // A closed mesh's back faces are hidden by its front ones: not drawing them halves the work.
     if (m.closed) glEnable(GL_CULL_FACE);
     glUniform3fv(program.Uniform("albedo"), 1, glm::value_ptr(m.albedo));

@@ -34,11 +34,12 @@ struct CompositeInput {
   estimation::SunSky light;           // E_sun (DNI) and E_sky, radiance units
   glm::vec3 sun_dir{0.0f, 0.0f, 1.0f};  // unit, toward the sun, scene coordinates
   const sh::IrradianceVolume* volume = nullptr;  // updated for this frame; always the same one; null: no indirect light
-  // Instead of the volume (null), directional lights and an ambient term (lightfit::EnvLights;
-  // as many as CompositorOptions::lights), each with a shadow map; `lights_reflected` per light: 1 when only the objects shadow
-  // it. Their shadow maps are redrawn when `lights_generation` changes.
-  const lightfit::LightSet* lights = nullptr;
-  const std::vector<uint8_t>* lights_reflected = nullptr;
+  // Instead of the volume (null), directional lights and an ambient term per object, in the
+  // scene's order (lightfit::EnvLights: the same directions for all, as many as
+  // CompositorOptions::lights, each light's irradiance as seen from that object), each light with
+  // a shadow map of the objects (the real model's occlusion is in each object's lights). The shadow
+  // maps are redrawn when `lights_generation` changes.
+  const std::vector<lightfit::LightSet>* lights = nullptr;
   int lights_generation = 0;
 };
 

@@ -172,11 +172,12 @@ TEST(CompositorTest, AnObjectInARealShadowGetsNoSun) {
   EXPECT_GT(f.At(image, camera.Project(facing(*sunlit))).x, 0.3f) << "the sphere in the sun is dark";
 }
 
-// --lighting lights:N: the lights and ambient instead of the volume, each light with its own
-// shadow map. One light along the sun (the sun itself dark): the sphere in a wall's shadow gets
-// the ambient alone, the one in the sun ambient + light·cos; flagged as light the model reflects,
-// the wall no longer blocks it.
-TEST(CompositorTest, LightsCastShadowsUnlessTheModelReflectsThem) {
+// --lighting lights:N: the lights and ambient instead of the volume, each object with its own
+// set (lightfit::EnvLights: the light as seen from where it stands), each light with a shadow map
+// of the objects only. One light along the sun (the sun itself dark): the sphere in a wall's shadow
+// gets the ambient alone when its set says the wall hides that light, ambient + light·cos when it
+// does not (the wall does not shadow it then); the one in the sun ambient + light·cos.
+TEST(CompositorTest, EachObjectTakesItsOwnLightsAndOnlyObjectsShadowThem) {
   Fixture f(0);
   const scene::CameraModel camera = f.scene.Camera();
   const auto [shadowed, sunlit] = FindShadowAndSun(f);
@@ -189,11 +190,12 @@ TEST(CompositorTest, LightsCastShadowsUnlessTheModelReflectsThem) {
   lightfit::LightSet lights;
   lights.ambient = glm::vec3(0.1f, 0.2f, 0.3f);
   lights.lights = {{f.sun, glm::vec3(10.0f, 20.0f, 30.0f)}};
-  std::vector<uint8_t> reflected = {0};
+  lightfit::LightSet hidden = lights;  // as seen from behind the wall
+  hidden.lights[0].irradiance = glm::vec3(0.0f);
+  std::vector<lightfit::LightSet> sets = {hidden, lights};  // the scene's order: shadowed, sunlit
   CompositeInput in;
   in.sun_dir = f.sun;  // E_sun = 0
-  in.lights = &lights;
-  in.lights_reflected = &reflected;
+  in.lights = &sets;
   in.lights_generation = 1;
   const auto facing = [&](const glm::dvec3& c) {
     return c + 0.15 * glm::normalize(glm::normalize(camera.CenterInWorld() - c) + glm::dvec3(f.sun));
@@ -216,12 +218,12 @@ TEST(CompositorTest, LightsCastShadowsUnlessTheModelReflectsThem) {
   compositor.Render(in, image.data());
   check(f.At(image, pixel(*shadowed)), expected(*shadowed, false), "behind the wall");
   check(f.At(image, pixel(*sunlit)), expected(*sunlit, true), "in the open");
-  // The same light as one the wall reflects: only the objects shadow it.
-  reflected = {1};
-  in.lights_generation = 2;
+  // The same light for both: the wall does not shadow it (each object's set holds what the model
+  // hides from it).
+  sets = {lights, lights};
   image = f.background;
   compositor.Render(in, image.data());
-  check(f.At(image, pixel(*shadowed)), expected(*shadowed, true), "reflected light behind the wall");
+  check(f.At(image, pixel(*shadowed)), expected(*shadowed, true), "behind the wall, its set lit");
 }
 
 }  // namespace

@@ -35,10 +35,10 @@ FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& b
   }
   if (options.lights > 0 && !scene.objects.empty()) {
     if (!scene.envmap) ThrowInputError("{}: --lighting lights:{} needs the scene's envmap", scene.file.string(), options.lights);
-    glm::vec3 lo, hi;
-    objects_model_.Bounds(&lo, &hi);
-    env_lights_ = std::make_unique<lightfit::EnvLights>(options.lights, caster, 0.5f * (lo + hi),
-                                                       glm::vec3(scene.envmap->position), bake.env.width, bake.env.height);
+    std::vector<glm::vec3> centres;
+    for (const scene::VirtualObject& o : scene.objects) centres.push_back(glm::vec3(o.position));
+    env_lights_ = std::make_unique<lightfit::EnvLights>(options.lights, caster, centres, glm::vec3(scene.envmap->position),
+                                                       bake.env.width, bake.env.height);
   }
 }
 
@@ -96,7 +96,6 @@ void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcas
   if (env_lights_) {
     // The lights are fitted again when the combination has drifted too far (lightfit::EnvLights).
     input.lights = &env_lights_->Update(e);
-    input.lights_reflected = &env_lights_->reflected();
     input.lights_generation = env_lights_->generation();
   } else if (volume_) {
     volume_->SetCombination({&volume_parts_[0], &volume_parts_[1], &volume_parts_[2]}, {e.sun, e.clear, e.overcast});

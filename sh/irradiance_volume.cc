@@ -44,7 +44,9 @@ size_t IrradianceVolume::InsideCount() const {
   return static_cast<size_t>(std::count(inside_.begin(), inside_.end(), 1));
 }
 
-void IrradianceVolume::Update(const std::vector<glm::vec3>& env_radiance) {
+void IrradianceVolume::Update(const std::vector<glm::vec3>& stacked_radiance) {
+  DAYLIT_CHECK(stacked_radiance.size() == 2 * gather_.map_texels, "a stacked map of {} values for an env map of {} texels",
+               stacked_radiance.size(), gather_.map_texels);
   const size_t dirs = gather_.directions.size();
   const size_t probes = gather_.ProbeCount();
   // Per probe: gather its radiances into one array per channel, then 27 dot products of length
@@ -57,7 +59,7 @@ void IrradianceVolume::Update(const std::vector<glm::vec3>& env_radiance) {
   for (size_t p = 0; p < probes; ++p) {
     const uint32_t* texel = &gather_.texel[p * dirs];
     for (size_t d = 0; d < dirs; ++d) {
-      const glm::vec3& l = env_radiance[texel[d]];
+      const glm::vec3& l = stacked_radiance[texel[d]];
       r[d] = l.x, g[d] = l.y, b[d] = l.z;
     }
     float* out = &coefficients_[p * kCoefficients * 3];

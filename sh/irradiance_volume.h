@@ -2,7 +2,7 @@
 // the L2 spherical-harmonic irradiance (9 RGB coefficients, Ramamoorthi & Hanrahan's cosine
 // convolution folded in) of the light arriving there from the relit environment map, with
 // parallax through the bake's gather tables (each probe direction reads the env texel that shows
-// the model point it hits). Updated every frame; evaluated at any point and normal by trilinear
+// the model point it hits, or the sky in its direction where it escapes). Updated every frame; evaluated at any point and normal by trilinear
 // interpolation of the coefficients. The sun is not in it: the renderer draws the sun as a
 // directional light with shadows, and keeping it out of the SH is what keeps SH9 accurate.
 //
@@ -31,9 +31,10 @@ class IrradianceVolume {
   // valid neighbours after each update instead of the black they would see.
   explicit IrradianceVolume(const GatherTables& gather, std::vector<uint8_t> inside = {});
 
-  // Recomputes every probe from the env map's radiance (one RGB per texel, row-major, sun
-  // excluded): the gather directions carry 4π/N sr each.
-  void Update(const std::vector<glm::vec3>& env_radiance);
+  // Recomputes every probe from the env map's radiance stacked on its sky layer (2·W·H RGB
+  // values: the map's texels row-major, then the sky's radiance in each texel's direction;
+  // bake/parallax.h), sun excluded: the gather directions carry 4π/N sr each.
+  void Update(const std::vector<glm::vec3>& stacked_radiance);
 
   // Sets the coefficients to Σ_i weights[i] · parts[i], channel by channel, `parts` being
   // coefficients() after updates from other maps: Update is linear, so this is the update from

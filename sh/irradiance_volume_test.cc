@@ -5,7 +5,9 @@
 #include <glm/gtc/constants.hpp>
 
 #include "bake/bake.h"
+#include "bake/sampling.h"
 #include "bake/synthetic_recording.h"
+#include "base/latlong.h"
 #include "base/log.h"
 #include "scene/raycaster.h"
 #include "scene/scene.h"
@@ -30,11 +32,25 @@ struct OpenGround {
   }
 };
 
+// `map` (W×H) stacked on its sky layer (bake/parallax.h): the synthetic recordings' sky, 1 above
+// the horizon and 0.4 below (what their maps show where the ground ends).
+std::vector<glm::vec3> Stacked(const std::vector<glm::vec3>& map, int width, int height) {
+  std::vector<glm::vec3> stacked = map;
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) stacked.push_back(glm::vec3(LatLongDirection(u, v, width, height).z > 0.0 ? 1.0f : 0.4f));
+  }
+  return stacked;
+}
+
+std::vector<glm::vec3> CapturedStacked(const bake::SceneBake& bake) {
+  return Stacked(bake.env.radiance, bake.env.width, bake.env.height);
+}
+
 TEST(IrradianceVolumeTest, OpenGroundGivesTheHemispheresIrradiance) {
   const OpenGround w("volume_open");
   IrradianceVolume volume(w.bake.gather, bake::ProbesInsideModel(w.bake.gather, *w.caster));
   EXPECT_EQ(volume.InsideCount(), 0u);
-  volume.Update(w.bake.env.radiance);
+  volume.Update(CapturedStacked(w.bake));
   // Sky 1 above, ground 0.4 below: facing up π, facing down 0.4π, sideways 0.7π (SH9 is exact
   // for these three on a two-level sphere; what is left is the 256-direction quadrature).
   const glm::vec3 up(0, 0, 1), down(0, 0, -1), side(1, 0, 0);
@@ -52,12 +68,62 @@ TEST(IrradianceVolumeTest, OpenGroundGivesTheHemispheresIrradiance) {
   EXPECT_NEAR(volume.Irradiance(glm::vec3(5.0f, 5.0f, 9.0f), down).x, 0.4f * glm::pi<float>(), 0.02f * glm::pi<float>());
 }
 
+// A direction that escapes from a probe reads the sky, also where the capture point sees the
+// model that way. Here the capture point stands 3 m in front of a bright wall 3 m high (radiance
+// 10, as a sunlit terracotta wall), so the map shows the wall up to 27° above the horizon toward
+// +Y; probes 10 m from the wall, just under its top, see it only below the horizon and sky above.
+// Their irradiance facing the wall is checked against a brute-force integral of the same scene
+// (Embree, 20 000 cosine-weighted rays, the radiance of what each ray meets).
+TEST(IrradianceVolumeTest, ADirectionThatEscapesReadsTheSkyNotWhatTheCapturePointSeesThatWay) {
+  bake::testing::SyntheticRecording rec("volume_sky_parallax");
+  rec.obj += "o wall\nv -50 3 0\nv 50 3 0\nv 50 3 3\nv -50 3 3\nf 5 8 7 6\n";
+  rec.env_width = 512;
+  const glm::dvec3 capture(0.0, 0.0, 1.5);
+  const auto radiance = [](bool wall, const glm::dvec3& d) { return wall ? 10.0f : d.z > 0.0 ? 1.0f : 0.4f; };
+  rec.env = [&](const glm::dvec3& d) {
+    const double t = d.y > 0.0 ? (3.0 - capture.y) / d.y : -1.0;
+    const glm::dvec3 p = capture + t * d;
+    return glm::vec3(radiance(t > 0.0 && std::abs(p.x) <= 50.0 && p.z >= 0.0 && p.z <= 3.0, d));
+  };
+  rec.scene["volume"] = {{"min", {-1, -8, 2.5}}, {"max", {1, -7, 2.9}}, {"resolution", {2, 2, 2}}};
+  SetLogVerbosity(0);
+  const scene::Scene scene = scene::LoadScene(rec.Write());
+  const bake::SceneBake baked = bake::RunBake(scene, bake::BakeOptions{});
+  const scene::RayCaster caster(scene.model);
+  const int wall = scene.model.SurfaceIndex("wall");
+  ASSERT_GE(wall, 0);
+  IrradianceVolume volume(baked.gather);
+  volume.Update(CapturedStacked(baked));
+  const glm::vec3 toward_wall(0.0f, 1.0f, 0.0f);
+  const std::vector<glm::vec3> hemisphere = bake::CosineHemisphere(20000);
+  for (int j = 0; j < 2; ++j) {
+    const glm::vec3 probe = baked.gather.ProbePosition(0, j, 1);
+    const glm::mat3 frame = bake::HemisphereFrame(toward_wall, 1u);
+    double right = 0.0, straight = 0.0;
+    for (const glm::vec3& local : hemisphere) {
+      const glm::vec3 dir = frame * local;
+      const scene::RayHit hit = caster.Intersect(probe, dir);
+      const bool meets_wall = hit.IsHit() && static_cast<int>(hit.surface) == wall;
+      right += radiance(meets_wall, glm::dvec3(dir));
+      // What reading the map straight in an escaping direction would give.
+      straight += hit.IsHit() ? radiance(meets_wall, glm::dvec3(dir)) : rec.env(glm::dvec3(dir)).x;
+    }
+    right *= glm::pi<double>() / static_cast<double>(hemisphere.size());
+    straight *= glm::pi<double>() / static_cast<double>(hemisphere.size());
+    const double got = volume.ProbeIrradiance(0, j, 1, toward_wall).x;
+    std::printf("probe %d m from the wall: volume %.3f, brute force %.3f (the map read straight: %.3f)\n",
+                static_cast<int>(std::lround(3.0f - probe.y)), got, right, straight);
+    EXPECT_NEAR(got, right, 0.03 * right);
+    EXPECT_GT(straight, 1.5 * right);  // the error this guards against
+  }
+}
+
 TEST(IrradianceVolumeTest, InterpolationIsTrilinearBetweenProbes) {
   const OpenGround w("volume_lerp");
   IrradianceVolume volume(w.bake.gather);
   // A made-up map: texel radiance grows with the texel index, so that probes differ (their
   // gather directions read different texels through parallax).
-  std::vector<glm::vec3> radiance(w.bake.env.radiance.size());
+  std::vector<glm::vec3> radiance(2 * w.bake.env.radiance.size());
   for (size_t t = 0; t < radiance.size(); ++t) radiance[t] = glm::vec3(static_cast<float>(t % 97) / 97.0f);
   volume.Update(radiance);
   const glm::vec3 n = glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f));
@@ -83,7 +149,7 @@ TEST(IrradianceVolumeTest, AProbeInsideAWallTakesItsNeighboursValues) {
   EXPECT_EQ(inside[0], 1);
   for (size_t p = 1; p < 8; ++p) EXPECT_EQ(inside[p], 0) << p;
   IrradianceVolume volume(w.bake.gather, inside);
-  volume.Update(w.bake.env.radiance);
+  volume.Update(CapturedStacked(w.bake));
   const glm::vec3 up(0, 0, 1);
   const float want = (volume.ProbeIrradiance(1, 0, 0, up).x + volume.ProbeIrradiance(0, 1, 0, up).x +
                       volume.ProbeIrradiance(0, 0, 1, up).x) / 3.0f;
@@ -102,7 +168,7 @@ TEST(IrradianceVolumeTest, CombiningUpdatesEqualsUpdatingTheCombinedMap) {
   const OpenGround w("volume_combine", faces);
   IrradianceVolume volume(w.bake.gather, bake::ProbesInsideModel(w.bake.gather, *w.caster));
   ASSERT_EQ(volume.InsideCount(), 1u);
-  const size_t texels = w.bake.env.radiance.size();
+  const size_t texels = 2 * w.bake.env.radiance.size();  // the map and its sky layer
   std::array<std::vector<glm::vec3>, 3> maps;
   std::array<std::vector<float>, 3> parts;
   for (size_t i = 0; i < 3; ++i) {

@@ -32,8 +32,8 @@ TEST(VolumeRecordingTest, CourtyardVolumeMatchesBruteForceIrradiance) {
   const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, 550, {});
   relight::EnvRelighter relighter(baked, glm::vec3(scene.envmap->position), caster);
   relighter.SetSun(fit.sun_dir);
-  std::vector<glm::vec3> env;
-  relighter.Relight(fit.fit.light, fit.fit.overcast_share, &env);
+  std::vector<glm::vec3> env;  // the relit map stacked on its sky layer (bake/parallax.h)
+  relighter.RelightWithSky(fit.fit.light, fit.fit.overcast_share, &env);
   sh::IrradianceVolume volume(baked.gather, bake::ProbesInsideModel(baked.gather, caster));
   volume.Update(env);
   const glm::vec3 capture(scene.envmap->position);
@@ -61,8 +61,11 @@ TEST(VolumeRecordingTest, CourtyardVolumeMatchesBruteForceIrradiance) {
     for (const glm::vec3& local : hemisphere) {
       const glm::vec3 dir = frame * local;
       const scene::RayHit hit = caster.Intersect(p, dir);
-      const glm::dvec3 toward = hit.IsHit() ? glm::dvec3(p + hit.t * dir - capture) : glm::dvec3(dir);
-      sum += glm::dvec3(env[static_cast<size_t>(LatLongTexel(toward, w, h))]);
+      // A ray that meets the model reads the texel that shows its hit from the capture point; one
+      // that escapes reads the sky in its direction (the stacked map's sky layer).
+      const size_t texel = hit.IsHit() ? static_cast<size_t>(LatLongTexel(glm::dvec3(p + hit.t * dir - capture), w, h))
+                                       : static_cast<size_t>(w) * h + static_cast<size_t>(LatLongTexel(glm::dvec3(dir), w, h));
+      sum += glm::dvec3(env[texel]);
     }
     const glm::dvec3 truth = glm::pi<double>() * sum / static_cast<double>(hemisphere.size());
     const glm::dvec3 got(volume.Irradiance(p, n));
