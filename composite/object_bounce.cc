@@ -13,21 +13,35 @@
 
 namespace daylit::composite {
 
+namespace {
+
+std::vector<glm::vec3> ShadingMeshes(const scene::Scene& scene, bool normals) {
+  std::vector<glm::vec3> out;
+  for (const scene::VirtualObject& o : scene.objects) {
+    const scene::Mesh m = scene::ShadingMesh(o, scene);
+    const std::vector<glm::vec3>& v = normals ? m.normals : m.positions;
+    out.insert(out.end(), v.begin(), v.end());
+  }
+  return out;
+}
+
+}  // namespace
+
 ObjectBounce::ObjectBounce(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& real,
                            const scene::RayCaster& objects, const ObjectBounceOptions& options)
+    : ObjectBounce(scene, bake, real, objects, ShadingMeshes(scene, false), ShadingMeshes(scene, true), options) {}
+
+ObjectBounce::ObjectBounce(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& real,
+                           const scene::RayCaster& objects, const std::vector<glm::vec3>& positions,
+                           const std::vector<glm::vec3>& normals, const ObjectBounceOptions& options)
     : real_(real), objects_(objects), options_(options) {
   DAYLIT_CHECK(options.Check().empty(), "{}", options.Check());
+  DAYLIT_CHECK(positions.size() == normals.size(), "{} points and {} normals", positions.size(), normals.size());
   // Albedo per real surface, by name from the bake's table.
   std::vector<glm::vec3> albedo(scene.model.surface_names.size(), glm::vec3(0.0f));
   for (const bake::SurfaceAlbedo& a : bake.albedo_table) {
     const int s = scene.model.SurfaceIndex(a.surface);
     if (s >= 0) albedo[static_cast<size_t>(s)] = a.albedo;
-  }
-  std::vector<glm::vec3> positions, normals;
-  for (const scene::VirtualObject& o : scene.objects) {
-    const scene::Mesh m = scene::ShadingMesh(o, scene);
-    positions.insert(positions.end(), m.positions.begin(), m.positions.end());
-    normals.insert(normals.end(), m.normals.begin(), m.normals.end());
   }
   sun_loss_.assign(positions.size(), glm::vec3(0.0f));
   sky_loss_.assign(positions.size(), glm::vec3(0.0f));

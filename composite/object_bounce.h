@@ -31,12 +31,17 @@ struct ObjectBounceOptions {
 
 class ObjectBounce {
  public:
+  // At the vertices of every object's scene::ShadingMesh, in order.
   ObjectBounce(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& real,
                const scene::RayCaster& objects, const ObjectBounceOptions& options = {});
+  // At the given points of the objects' surfaces, with unit normals facing out.
+  ObjectBounce(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& real,
+               const scene::RayCaster& objects, const std::vector<glm::vec3>& positions,
+               const std::vector<glm::vec3>& normals, const ObjectBounceOptions& options = {});
 
   bool SetSun(const glm::vec3& sun_dir);
 
-  // Per vertex, all objects in order: the irradiance lost per unit E_sun and per unit E_sky.
+  // Per vertex (or point), in order: the irradiance lost per unit E_sun and per unit E_sky.
   const std::vector<glm::vec3>& sun_loss() const { return sun_loss_; }
   const std::vector<glm::vec3>& sky_loss() const { return sky_loss_; }
 

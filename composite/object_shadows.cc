@@ -61,7 +61,7 @@ ObjectShadows::ObjectShadows(const scene::Scene& scene, const bake::SceneBake& b
   const glm::vec3 capture = scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f);
   const int env_w = bake.env.width, env_h = bake.env.height;
   std::vector<Affected> found(near.size());
-  std::vector<std::vector<uint32_t>> texels(near.size());
+  std::vector<std::vector<uint32_t>> texels(near.size()), sides(near.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, near.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
       const uint32_t p = near[i];
@@ -81,6 +81,7 @@ ObjectShadows::ObjectShadows(const scene::Scene& scene, const bake::SceneBake& b
         // sky in that direction (bake/parallax.h).
         const scene::RayHit behind = real_.Intersect(origin, dir, object.t);
         texels[i].push_back(bake::ParallaxTexel(origin, dir, behind, capture, env_w, env_h));
+        sides[i].push_back(2 * object.triangle + (object.back_face ? 1u : 0u));
         sky += behind.IsHit() ? 0 : 1;
       }
       a.sky_lost = static_cast<float>(sky) / static_cast<float>(hemisphere.size());
@@ -93,14 +94,49 @@ ObjectShadows::ObjectShadows(const scene::Scene& scene, const bake::SceneBake& b
     found[i].first = static_cast<uint32_t>(covered_texels_.size());
     found[i].count = static_cast<uint32_t>(texels[i].size());
     covered_texels_.insert(covered_texels_.end(), texels[i].begin(), texels[i].end());
+    covered_sides_.insert(covered_sides_.end(), sides[i].begin(), sides[i].end());
     FindNeighbours(&found[i]);
     affected_.push_back(found[i]);
+  }
+  // The sides met, and each covered ray's side as an index among them.
+  reflecting_sides_ = covered_sides_;
+  std::sort(reflecting_sides_.begin(), reflecting_sides_.end());
+  reflecting_sides_.erase(std::unique(reflecting_sides_.begin(), reflecting_sides_.end()), reflecting_sides_.end());
+  for (uint32_t& side : covered_sides_) {
+    side = static_cast<uint32_t>(std::lower_bound(reflecting_sides_.begin(), reflecting_sides_.end(), side) - reflecting_sides_.begin());
   }
   pi_over_albedo_.resize(pixels);
   for (size_t p = 0; p < pixels; ++p) pi_over_albedo_[p] = glm::pi<float>() / glm::max(gbuffer.albedo[p], glm::vec3(1e-3f));
 }
 
 constexpr uint32_t kAllNeighbours = (1u << 25) - 1;
+// The most a pixel can brighten by what the objects reflect onto it: a bound against a B read
+// low from a dark, noisy neighbourhood, far above what a diffuse object gives back.
+constexpr float kMostGain = 2.0f;
+
+ObjectShadows::Footprint ObjectShadows::FootprintOf(uint32_t pixel) const {
+  // The surface's step per pixel along x and y, from the G-buffer's neighbours on the same plane
+  // (a central difference, else one-sided; none at a lone pixel).
+  const int w = gbuffer_.width, h = gbuffer_.height;
+  const int x = static_cast<int>(pixel % static_cast<uint32_t>(w)), y = static_cast<int>(pixel / static_cast<uint32_t>(w));
+  const glm::vec3 p = gbuffer_.point[pixel], n = gbuffer_.normal[pixel];
+  const auto on_plane = [&](int u, int v, glm::vec3* q) {
+    if (u < 0 || v < 0 || u >= w || v >= h) return false;
+    const size_t i = static_cast<size_t>(v) * static_cast<size_t>(w) + static_cast<size_t>(u);
+    if (gbuffer_.surface[i] != gbuffer_.surface[pixel] || glm::dot(gbuffer_.normal[i], n) < 0.999f) return false;
+    *q = gbuffer_.point[i];
+    return std::abs(glm::dot(*q - p, n)) < 1e-3f;
+  };
+  const auto step = [&](int du, int dv) {
+    glm::vec3 a(0.0f), b(0.0f);
+    const bool ahead = on_plane(x + du, y + dv, &a), behind = on_plane(x - du, y - dv, &b);
+    if (ahead && behind) return 0.5f * (a - b);
+    if (ahead) return a - p;
+    if (behind) return p - b;
+    return glm::vec3(0.0f);
+  };
+  return {step(1, 0), step(0, 1)};
+}
 
 void ObjectShadows::FindNeighbours(Affected* a) const {
   const int w = gbuffer_.width, h = gbuffer_.height;
@@ -132,18 +168,43 @@ void ObjectShadows::SetEnvBasis(const relight::EnvBasis& basis) {
   loss_ready_ = false;
 }
 
+void ObjectShadows::SetObjectRadiance(const std::array<std::vector<glm::vec3>, 3>& radiance) {
+  for (const std::vector<glm::vec3>& part : radiance) {
+    DAYLIT_CHECK(part.size() == reflecting_sides_.size(), "radiance for {} sides, not {}", part.size(), reflecting_sides_.size());
+  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, affected_.size(), 1024), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      Affected& a = affected_[i];
+      glm::vec3 sun(0.0f), clear(0.0f), overcast(0.0f);
+      for (uint32_t k = a.first; k < a.first + a.count; ++k) {
+        const uint32_t side = covered_sides_[k];
+        sun += radiance[0][side], clear += radiance[1][side], overcast += radiance[2][side];
+      }
+      a.reflected_sun = ray_weight_ * sun, a.reflected_clear = ray_weight_ * clear, a.reflected_overcast = ray_weight_ * overcast;
+    }
+  });
+  loss_ready_ = false;
+}
+
 bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
   const glm::vec3 sun = glm::normalize(sun_dir);
   if (has_sun_ && sun == sun_) return false;  // the caller decides when it moved (scene::SunTracker)
   sun_ = sun, has_sun_ = true;
-  // Directions over the sun's disc (radius 0.2665°), a Fibonacci spiral of equal areas.
+  // Directions over the sun's disc (radius 0.2665°), a Fibonacci spiral of equal areas, each with
+  // a place in the pixel (a stratified grid, visited in a scrambled order so that the disc's
+  // rings and the pixel's rows do not line up).
   disc_.clear();
+  jitter_.clear();
+  const int grid = static_cast<int>(std::ceil(std::sqrt(static_cast<float>(options_.sun_rays))));
   const glm::mat3 basis = bake::BasisAround(sun);
   const float radius = std::tan(glm::radians(0.2665f));
   for (int k = 0; k < options_.sun_rays; ++k) {
     const float r = radius * std::sqrt((static_cast<float>(k) + 0.5f) / static_cast<float>(options_.sun_rays));
     const float phi = 2.39996323f * static_cast<float>(k);
     disc_.push_back(glm::normalize(sun + r * (std::cos(phi) * basis[0] + std::sin(phi) * basis[1])));
+    const int cell = (k * 7 + 3) % (grid * grid);
+    jitter_.emplace_back((static_cast<float>(cell % grid) + 0.5f) / static_cast<float>(grid) - 0.5f,
+                         (static_cast<float>(cell / grid) + 0.5f) / static_cast<float>(grid) - 0.5f);
   }
   // Keep the sky-loss pixels, drop the previous sun's shadow-only ones, then find this sun's.
   std::erase_if(affected_, [](const Affected& a) { return !a.covers; });
@@ -174,10 +235,18 @@ bool ObjectShadows::SetSun(const glm::vec3& sun_dir) {
       a.cos_sun = std::max(0.0f, glm::dot(n, sun));
       // The sun is a disc: the share of it the objects newly hide gives the penumbrae. A ray
       // counts when an object stops it and the real model does not (no double darkening); the
-      // objects' few triangles are asked first.
+      // objects' few triangles are asked first. Each ray leaves from another point of the
+      // pixel's footprint, so that the share is the pixel's, as a camera integrates it: an edge
+      // sampled at pixel centres only is a staircase of full and no shadow, each pixel up to half
+      // a pixel's light off (courtyard-a's sunny frames: most of the shadows' error).
       int lost = 0;
       if (a.cos_sun > 0.0f && sun_may_meet_object(origin)) {
-        for (const glm::vec3& d : disc_) lost += objects_.Occluded(origin, d) && !real_.Occluded(origin, d) ? 1 : 0;
+        const Footprint f = FootprintOf(a.pixel);
+        for (size_t k = 0; k < disc_.size(); ++k) {
+          const glm::vec2 j = jitter_[k];
+          const glm::vec3 from = origin + j.x * f.dx + j.y * f.dy;
+          lost += objects_.Occluded(from, disc_[k]) && !real_.Occluded(from, disc_[k]) ? 1 : 0;
+        }
       }
       a.sun_lost = static_cast<float>(lost) / static_cast<float>(disc_.size());
     }
@@ -202,6 +271,9 @@ void ObjectShadows::PrepareLoss() {
     } else {
       l.clear = l.overcast = glm::vec3(a.sky_lost);  // E_sky · the covered share
     }
+    // What the objects send back the same way (0 until SetObjectRadiance): the loss can turn into
+    // a gain.
+    l.sun -= a.reflected_sun, l.clear -= a.reflected_clear, l.overcast -= a.reflected_overcast;
   }
   const uint32_t w = static_cast<uint32_t>(gbuffer_.width);
   row_begin_.assign(static_cast<size_t>(gbuffer_.height) + 1, 0);
@@ -262,7 +334,7 @@ void ObjectShadows::Apply(const estimation::SunSky& light, double overcast_share
         }
         const glm::vec3 lost = estimation::Irradiance(e, a.sun, a.clear, a.overcast);
         float* p = rgb + 3 * static_cast<size_t>(a.pixel);
-        for (int c = 0; c < 3; ++c) p[c] *= b[c] > 0.0f ? std::clamp(1.0f - lost[c] / b[c], 0.0f, 1.0f) : 1.0f;
+        for (int c = 0; c < 3; ++c) p[c] *= b[c] > 0.0f ? std::clamp(1.0f - lost[c] / b[c], 0.0f, kMostGain) : 1.0f;
       }
     }
   });

@@ -25,12 +25,15 @@ FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& b
       objects_(objects_model_),
       shadows_(scene, bake, caster, objects_),
       bounce_(scene, bake, caster, objects_),
+      object_light_(scene, bake, caster, objects_, shadows_.ReflectingSides()),
       relighter_(bake, scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f), caster),
       compositor_(scene, CompositorFor(options, scene)),
       linearizer_(scene.response) {
   DAYLIT_CHECK(options.Check().empty(), "{}", options.Check());
   scene::CheckObjectsOutsideModel(objects_model_, caster, scene.file.string());
-  if (options.lights == 0 && !bake.gather.directions.empty()) {
+  // The volume lights the objects, or with lights:N gives what the objects reflect onto the real
+  // surfaces only.
+  if (!bake.gather.directions.empty()) {
     volume_ = std::make_unique<sh::IrradianceVolume>(bake.gather, bake::ProbesInsideModel(bake.gather, caster));
   }
   if (options.lights > 0 && !scene.objects.empty()) {
@@ -82,15 +85,14 @@ void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcas
     if (relighter_.SetSun(sun_dir)) {
       relighter_.Basis(&basis_);
       shadows_.SetEnvBasis(basis_);
-      if (env_lights_) {
-        env_lights_->SetBasis(basis_);
-      } else {
-        const std::vector<glm::vec3>* maps[3] = {&basis_.sun, &basis_.clear, &basis_.overcast};
-        for (size_t i = 0; i < 3; ++i) {
-          volume_->Update(*maps[i]);
-          volume_parts_[i] = volume_->coefficients();
-        }
+      if (env_lights_) env_lights_->SetBasis(basis_);
+      const std::vector<glm::vec3>* maps[3] = {&basis_.sun, &basis_.clear, &basis_.overcast};
+      for (size_t i = 0; i < 3; ++i) {
+        if (!volume_) continue;
+        volume_->Update(*maps[i]);
+        volume_parts_[i] = volume_->coefficients();
       }
+      UpdateObjectLight(sun_dir);
     }
   }
   if (env_lights_) {
@@ -104,6 +106,25 @@ void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcas
   shadows_.SetSun(sun_dir);
   shadows_.Apply(light, overcast_share, image);
   compositor_.Render(input, image);
+}
+
+void FrameRenderer::UpdateObjectLight(const glm::vec3& sun_dir) {
+  // Each side's indirect light, part by part, from the volume (none without one).
+  const std::vector<glm::vec3>& points = object_light_.points();
+  const std::vector<glm::vec3>& normals = object_light_.normals();
+  std::array<std::vector<glm::vec3>, 3> indirect;
+  for (size_t k = 0; k < 3; ++k) {
+    indirect[k].assign(points.size(), glm::vec3(0.0f));
+    if (!volume_) continue;
+    std::array<glm::vec3, 3> unit = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
+    unit[k] = glm::vec3(1.0f);
+    volume_->SetCombination({&volume_parts_[0], &volume_parts_[1], &volume_parts_[2]}, unit);
+    for (size_t i = 0; i < points.size(); ++i) indirect[k][i] = volume_->Irradiance(points[i], normals[i]);
+  }
+  object_light_.SetSun(sun_dir);
+  std::array<std::vector<glm::vec3>, 3> radiance;
+  object_light_.Radiance(indirect, &radiance);
+  shadows_.SetObjectRadiance(radiance);
 }
 
 std::string FrameRendererOptions::Check() const {

@@ -1,8 +1,9 @@
 // One frame of the augmented video, from a fitted frame (estimation::FitFrame or the replay's
 // estimate) to the composite in linear radiance units: the frame linearised with the camera
 // response and its exposure divided out, the objects' shadows and sky loss applied to the real
-// surfaces (composite::ObjectShadows), the environment map relit with the estimate and the
-// irradiance volume updated from it, then the objects drawn (Compositor). Needs a current GL
+// surfaces (composite::ObjectShadows) less what the objects reflect onto them
+// (composite::ObjectLight), the environment map relit with the estimate and the irradiance
+// volume updated from it, then the objects drawn (Compositor). Needs a current GL
 // context; everything sun-dependent is recomputed only when the sun has moved.
 #pragma once
 
@@ -18,6 +19,7 @@
 #include "relight/env_relight.h"
 #include "sh/irradiance_volume.h"
 #include "composite/object_bounce.h"
+#include "composite/object_light.h"
 #include "composite/object_shadows.h"
 #include "scene/raycaster.h"
 #include "scene/scene.h"
@@ -59,12 +61,16 @@ class FrameRenderer {
   int height() const { return compositor_.height(); }
 
  private:
+  // The objects' own radiance for a new sun, from the volume's parts (composite::ObjectLight).
+  void UpdateObjectLight(const glm::vec3& sun_dir);
+
   const scene::Scene& scene_;
   const scene::RayCaster& caster_;
   scene::SceneModel objects_model_;  // before objects_, which keeps a reference to it
   scene::RayCaster objects_;
   composite::ObjectShadows shadows_;
   composite::ObjectBounce bounce_;
+  composite::ObjectLight object_light_;  // what the objects reflect onto the real surfaces
   relight::EnvRelighter relighter_;
   std::unique_ptr<sh::IrradianceVolume> volume_;
   Compositor compositor_;
