@@ -52,16 +52,25 @@ glm::vec3 RadianceAt(const CaptureScene& capture, const glm::vec3& y, const scen
 
 }  // namespace
 
+// A texel stands for y only if it shows a point this close to it: light under an overhang
+// changes over a fraction of a metre, and a texel that grazes a roof's underside shows a point up
+// to 1.6 m nearer its lit edge. Farther, y is hidden, and takes its cell's light.
+constexpr float kMostSlack = 0.25f;
+
 bool CaptureSees(const glm::vec3& toward, const glm::vec3& normal, uint32_t surface, float seen_distance,
                  uint32_t seen_surface, const glm::vec3& seen_normal, int env_height) {
   // The capture point sees y unless its own ray toward y stops clearly short of it. The texel's
   // ray can be up to a texel off y's direction; on y's own surface seen at a grazing angle that
   // moves its hit along the surface by distance·angle / cos, so the slack grows with obliquity.
   const float distance = glm::length(toward);
+  // The side of y that is looked at must face the capture point: from behind its plane the
+  // capture point sees another side (a slab's sunlit top, seen from a wall above it, is its
+  // underside from a capture point below it), however close the texel's hit is.
+  if (glm::dot(normal, toward) >= 0.0f) return false;
   const float texel_angle = 2.0f * glm::pi<float>() / static_cast<float>(env_height);
   const bool same_surface = seen_surface == surface && glm::dot(seen_normal, normal) > 0.9f;
   const float obliquity = std::max(0.05f, std::abs(glm::dot(normal, toward / distance)));
-  const float slack = 0.05f + distance * texel_angle * (same_surface ? 2.0f / obliquity : 2.0f);
+  const float slack = std::min(kMostSlack, 0.05f + distance * texel_angle * (same_surface ? 2.0f / obliquity : 2.0f));
   return seen_distance >= 0.0f && seen_distance >= distance - slack;
 }
 
@@ -141,22 +150,28 @@ void GatherHiddenCells(const CaptureScene& capture, const RayOptions& options, c
   std::vector<std::pair<uint64_t, Found>> list(cells.begin(), cells.end());
   std::vector<glm::vec3> indirect(list.size());
   const float inv_rays = 1.0f / static_cast<float>(hemisphere.size());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, list.size(), 16), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t k = range.begin(); k != range.end(); ++k) {
-      const Found& f = list[k].second;
-      const glm::vec3 origin =
-          SurfaceCellOrigin(f.point, f.normal, HiddenSurfaceModel::kCellSize) + options.offset_m * f.normal;
-      const glm::mat3 frame = HemisphereFrame(f.normal, static_cast<uint32_t>(list[k].first));
-      glm::vec3 sum(0.0f);
-      for (const glm::vec3& local : hemisphere) {
-        const glm::vec3 dir = frame * local;
-        const scene::RayHit hit = capture.caster->Intersect(origin, dir);
-        sum += hit.IsHit() ? RadianceAt(capture, origin + hit.t * dir, hit) : Lookup(*capture.sky, dir);
+  // Twice: first the hidden points a cell sees take their surface's indirect light, then their
+  // own cells' from the first pass. Under an arcade the hidden points are mostly other hidden
+  // cells (the roof's underside sees the wall behind the pillars and the floor beneath it), and a
+  // surface's median, taken over its open and lit parts, gave them a third too much.
+  for (int pass = 0; pass < 2; ++pass) {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, list.size(), 16), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t k = range.begin(); k != range.end(); ++k) {
+        const Found& f = list[k].second;
+        const glm::vec3 origin =
+            SurfaceCellOrigin(f.point, f.normal, HiddenSurfaceModel::kCellSize) + options.offset_m * f.normal;
+        const glm::mat3 frame = HemisphereFrame(f.normal, static_cast<uint32_t>(list[k].first));
+        glm::vec3 sum(0.0f);
+        for (const glm::vec3& local : hemisphere) {
+          const glm::vec3 dir = frame * local;
+          const scene::RayHit hit = capture.caster->Intersect(origin, dir);
+          sum += hit.IsHit() ? RadianceAt(capture, origin + hit.t * dir, hit) : Lookup(*capture.sky, dir);
+        }
+        indirect[k] = glm::pi<float>() * inv_rays * sum;
       }
-      indirect[k] = glm::pi<float>() * inv_rays * sum;
-    }
-  });
-  for (size_t k = 0; k < list.size(); ++k) hidden->cell_indirect[list[k].first] = indirect[k];
+    });
+    for (size_t k = 0; k < list.size(); ++k) hidden->cell_indirect[list[k].first] = indirect[k];
+  }
 }
 
 void SkyVisibility(const scene::RayCaster& caster, const RayOptions& options, const glm::vec3* points,

@@ -88,11 +88,11 @@ TEST(EstimateRecordingTest, CourtyardAEveryBurstWithin5Percent) {
 }
 
 TEST(EstimateRecordingTest, CourtyardCEveryBurstWithin5Percent) {
-  // Burst 1: E_sky red 8.6% high (the arcade wall's albedo, 4.6% low, is most of the shadow).
-  // The 90th percentile: measured 8.8%. The confidence's AUC, measured 0.80, is short of the
-  // issue's 0.9: burst 1's clear frames (E_sky red just over 10%) are as well posed as burst 3's
-  // (within 5%); what sets them apart is the arcade wall's albedo, which no per-frame figure sees.
-  ExpectPerBurst(testing::CourtyardC(), {{1, 0.05, 0.10}}, 0.10, 0.75);
+  // Burst 1: E_sky red 5.4% high (the arcade wall, most of the shadow, 3.0% low in albedo).
+  // The 90th percentile: measured 6.7%. The confidence's AUC, measured 0.75, is short of the
+  // issue's 0.9: the frames over 10% are burst 1's under a cloud (E_sun blue 10-11% high), as
+  // well posed a split as the clear ones.
+  ExpectPerBurst(testing::CourtyardC(), {{1, 0.05, 0.065}}, 0.10, 0.75);
 }
 
 TEST(EstimateRecordingTest, EveryDiffuseSurfaceInShadeIsSaidNotNaN) {
