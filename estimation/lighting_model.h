@@ -24,11 +24,18 @@ struct SunSky {
   glm::dvec3 sky_rgb{0.0};  // E_sky, DHI
 };
 
-// The three parts of the light, RGB, ≥ 0: E_sun, E_clear = (1 − o)·E_sky, E_overcast = o·E_sky.
+// The three parts of the light, RGB, ≥ 0: E_sun, E_clear and E_overcast, E_clear + E_overcast =
+// E_sky.
 struct LightParts {
   glm::vec3 sun{0.0f}, clear{0.0f}, overcast{0.0f};
 };
-// The parts of `light` with the overcast share o = E_overcast / E_sky (clamped to [0, 1]).
+// The parts of `light` with the overcast share o (clamped to [0, 1]). Clouds are grey: the
+// overcast part is the same in every channel, o times E_sky's mean over the channels (at most
+// E_sky in each), and the clear part, the rest, carries the sky's colour. An overcast part with
+// the sky's own colour (o·E_sky per channel) made the clear sky's blue, mixed into a passing
+// cloud, into overcast blue: under a cloud the fit then took 2% of E_sky's blue for sun, E_sun's
+// blue 6-10% high (courtyard-a's overcast burst, courtyard-c's cloud in burst 1). "Grey" is the
+// camera's white: equal linear RGB.
 LightParts SplitLight(const SunSky& light, double overcast_share);
 
 // Irradiance at a point per unit of each part, RGB (reflected light takes the colour of the

@@ -22,11 +22,20 @@ TEST(LightingModelTest, RecordingFormatDefinitionOfUnits) {
   }
 }
 
-TEST(LightingModelTest, TheSkySplitsIntoItsPartsAndTheShareIsClamped) {
+TEST(LightingModelTest, TheSkySplitsIntoAGreyOvercastAndAClearRestAndTheShareIsClamped) {
   const SunSky light{{100, 100, 100}, {10, 20, 30}};
+  // Grey: a quarter of E_sky's mean (20) in every channel; the clear part keeps the colour.
   const LightParts parts = SplitLight(light, 0.25);
-  EXPECT_FLOAT_EQ(parts.clear.y + parts.overcast.y, 20.0f);
-  EXPECT_FLOAT_EQ(parts.overcast.z, 7.5f);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_FLOAT_EQ(parts.overcast[c], 5.0f) << c;
+    EXPECT_FLOAT_EQ(parts.clear[c] + parts.overcast[c], static_cast<float>(light.sky_rgb[c])) << c;
+  }
+  // At most E_sky in a channel: a share of 1 leaves red no clear part, blue some.
+  const LightParts full = SplitLight(light, 1.0);
+  EXPECT_FLOAT_EQ(full.overcast.x, 10.0f);
+  EXPECT_FLOAT_EQ(full.clear.x, 0.0f);
+  EXPECT_FLOAT_EQ(full.overcast.z, 20.0f);
+  EXPECT_FLOAT_EQ(full.clear.z, 10.0f);
   EXPECT_FLOAT_EQ(SplitLight(light, 1.7).clear.x, 0.0f);
   EXPECT_FLOAT_EQ(SplitLight(light, -0.2).overcast.x, 0.0f);
 }

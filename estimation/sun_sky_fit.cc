@@ -102,7 +102,7 @@ namespace {
 class ChannelFitter {
  public:
   ChannelFitter(const SunSkyFitOptions& options, const std::vector<Sample>& samples, size_t count, bool with_sun)
-      : options_(options), samples_(samples), with_sun_(with_sun), y_(count), w_(count), relative_(count),
+      : options_(options), samples_(samples), with_sun_(with_sun), y_(count), w_(count), relative_(count), offset_(count),
         x_{std::vector<double>(count), std::vector<double>(count), std::vector<double>(count)},
         stride_(std::max<size_t>(1, count / 2000)) {
     scratch_.reserve(count);
@@ -115,11 +115,11 @@ class ChannelFitter {
   const std::vector<double>& relative() const { return relative_; }
   bool converged() const { return converged_; }
 
-  // Channel `c` over the samples `rows`: E_sun and E_sky, or, with `split`, E_sun, E_clear and
-  // E_overcast; without, the sky's regressor is the clear one and the overcast one mixed by
-  // `share`. `start`, if given, replaces the median-based start.
-  ChannelFit Fit(int c, bool split, double share, const ChannelFit* start, const std::vector<size_t>& rows) {
-    Load(c, split, share, rows);
+  // Channel `c` over the samples `rows`: with `split`, E_sun, E_clear and E_overcast; without,
+  // E_sun and E_clear with E_overcast given as `overcast` (the grey part, the same in every
+  // channel). `start`, if given, replaces the median-based start.
+  ChannelFit Fit(int c, bool split, double overcast, const ChannelFit* start, const std::vector<size_t>& rows) {
+    Load(c, split, overcast, rows);
     ChannelFit fit = start != nullptr ? *start : MedianStart(rows);
     fit = Reweight(fit, split);
     for (size_t k = 0; k < m_; ++k) {
@@ -134,10 +134,12 @@ class ChannelFitter {
     return Eigen::Map<Eigen::ArrayXd>(v.data(), static_cast<Eigen::Index>(m_));
   }
   double Predict(const ChannelFit& fit, size_t k) const {
-    return x_[0][k] * fit[0] + x_[1][k] * fit[1] + x_[2][k] * fit[2];
+    return offset_[k] + x_[0][k] * fit[0] + x_[1][k] * fit[1] + x_[2][k] * fit[2];
   }
 
-  void Load(int c, bool split, double share, const std::vector<size_t>& rows) {
+  // y_ holds the samples' radiance, offset_ the known part of it (the given overcast light's),
+  // x_ the regressors of the unknowns.
+  void Load(int c, bool split, double overcast, const std::vector<size_t>& rows) {
     m_ = rows.size();
     free_ = {with_sun_, true, split};
     for (size_t k = 0; k < m_; ++k) {
@@ -145,15 +147,17 @@ class ChannelFitter {
       const double a = s.albedo[c] * glm::one_over_pi<double>();
       y_[k] = s.radiance[c];
       x_[0][k] = a * s.sun[c];
-      x_[1][k] = split ? a * s.sky[c] : a * ((1.0 - share) * s.sky[c] + share * s.overcast[c]);
+      x_[1][k] = a * s.sky[c];
       x_[2][k] = split ? a * s.overcast[c] : 0.0;
+      offset_[k] = split ? 0.0 : a * overcast * s.overcast[c];
     }
   }
 
   // The weighted normal equations of the samples with the weights in w_ (all three regressors;
-  // an unused one is zero), vectorised by Eigen.
+  // an unused one is zero) for the radiance less its known part, vectorised by Eigen.
   NormalEquations Equations() {
-    const Eigen::Map<Eigen::ArrayXd> ey = Column(y_), ex0 = Column(x_[0]), ex1 = Column(x_[1]), ex2 = Column(x_[2]);
+    const Eigen::ArrayXd ey = Column(y_) - Column(offset_);
+    const Eigen::Map<Eigen::ArrayXd> ex0 = Column(x_[0]), ex1 = Column(x_[1]), ex2 = Column(x_[2]);
     const Eigen::Map<Eigen::ArrayXd> ew = Column(w_);
     NormalEquations eq;
     const Eigen::ArrayXd w0 = ew * ex0, w1 = ew * ex1, w2 = ew * ex2;
@@ -171,7 +175,7 @@ class ChannelFitter {
     ChannelFit fit{0.0, 0.0, 0.0};
     scratch_.clear();
     for (size_t k = 0; k < m_; k += stride_) {
-      if (!samples_[rows[k]].sunlit && x_[1][k] > 0.0) scratch_.push_back(y_[k] / x_[1][k]);
+      if (!samples_[rows[k]].sunlit && x_[1][k] > 0.0) scratch_.push_back((y_[k] - offset_[k]) / x_[1][k]);
     }
     fit[1] = MedianInPlace(scratch_, 0.0);
     if (scratch_.empty()) {
@@ -180,7 +184,7 @@ class ChannelFitter {
     }
     scratch_.clear();
     for (size_t k = 0; k < m_; k += stride_) {
-      if (IsSunlit(samples_[rows[k]], options_)) scratch_.push_back((y_[k] - x_[1][k] * fit[1]) / x_[0][k]);
+      if (IsSunlit(samples_[rows[k]], options_)) scratch_.push_back((y_[k] - offset_[k] - x_[1][k] * fit[1]) / x_[0][k]);
     }
     if (with_sun_ && !scratch_.empty()) fit[0] = std::max(0.0, MedianInPlace(scratch_, 0.0));
     return fit;
@@ -196,13 +200,14 @@ class ChannelFitter {
     floor_ = std::max(1e-12, 0.1 * MedianInPlace(scratch_, 0.0));
     const double inv_scale = 1.0 / options_.cauchy_scale;
     const Eigen::Map<Eigen::ArrayXd> ey = Column(y_), ex0 = Column(x_[0]), ex1 = Column(x_[1]), ex2 = Column(x_[2]);
+    const Eigen::Map<Eigen::ArrayXd> eoffset = Column(offset_);
     Eigen::Map<Eigen::ArrayXd> ew = Column(w_);
     const double tolerance = split ? 1e-3 : 1e-4;
     converged_ = false;
     for (int iteration = 0; iteration < options_.iterations && !converged_; ++iteration) {
       // Least squares on relative residuals: 1/scale² times the Cauchy weight 1/(1 + r²), that
       // is 1/(scale² + d²/c²) for a residual d.
-      const Eigen::ArrayXd prediction = ex0 * fit[0] + ex1 * fit[1] + ex2 * fit[2];
+      const Eigen::ArrayXd prediction = eoffset + ex0 * fit[0] + ex1 * fit[1] + ex2 * fit[2];
       const Eigen::ArrayXd d = ey - prediction;
       ew = (prediction.max(floor_).square() + d.square() * (inv_scale * inv_scale)).inverse();
       const ChannelFit next = SolveNonNegative(Equations(), free_);
@@ -218,7 +223,7 @@ class ChannelFitter {
   const SunSkyFitOptions& options_;
   const std::vector<Sample>& samples_;
   const bool with_sun_;
-  std::vector<double> y_, w_, relative_, scratch_;
+  std::vector<double> y_, w_, relative_, scratch_, offset_;
   std::array<std::vector<double>, 3> x_;
   const size_t stride_;
   size_t m_ = 0;
@@ -227,21 +232,20 @@ class ChannelFitter {
   bool converged_ = false;
 };
 
-// The overcast share of the sky is one number for all channels (clouds are grey): fitted per
-// channel on half the samples, then pooled. Per-channel shares let a small model error in one
-// channel trade sun for sky there. Also returns each channel's split fit in `split_fits`.
-double PooledOvercastShare(ChannelFitter* fitter, const std::vector<size_t>& usable,
-                           std::array<ChannelFit, 3>* split_fits) {
+// The overcast part of the sky is grey, one value for all channels (lighting_model.h): fitted
+// per channel on half the samples, then pooled (the mean over the channels). Per-channel parts let
+// a small model error in one channel trade sun for sky there. Also returns each channel's split
+// fit in `split_fits`.
+double PooledOvercast(ChannelFitter* fitter, const std::vector<size_t>& usable, std::array<ChannelFit, 3>* split_fits) {
   std::vector<size_t> every_other;
   for (size_t k = 0; k < usable.size(); k += 2) every_other.push_back(usable[k]);
-  glm::dvec3 clear(0.0), overcast(0.0);
+  double overcast = 0.0;
   for (int c = 0; c < 3; ++c) {
     ChannelFit& fit = (*split_fits)[static_cast<size_t>(c)];
     fit = fitter->Fit(c, true, 0.0, nullptr, every_other);
-    clear[c] = fit[1], overcast[c] = fit[2];
+    overcast += fit[2] / 3.0;
   }
-  const double sky = glm::compAdd(clear + overcast);
-  return sky > 0.0 ? glm::compAdd(overcast) / sky : 0.0;
+  return overcast;
 }
 
 // The worst channel's share of the sunlit samples' predicted light that is direct sun, and of the
@@ -292,9 +296,8 @@ double Confidence(const SunSkyFitOptions& options, const SunSkyFitSummary& summa
 }  // namespace
 
 glm::vec3 PredictedRadiance(const Sample& s, const SunSky& light, double overcast_share) {
-  const glm::dvec3 sky = (1.0 - overcast_share) * glm::dvec3(s.sky) + overcast_share * glm::dvec3(s.overcast);
-  return glm::vec3(glm::dvec3(s.albedo) * glm::one_over_pi<double>() *
-                   (glm::dvec3(s.sun) * light.sun_rgb + sky * light.sky_rgb));
+  const LightParts e = SplitLight(light, overcast_share);
+  return s.albedo * glm::one_over_pi<float>() * Irradiance(e, s.sun, s.sky, s.overcast);
 }
 
 SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sample>& samples) {
@@ -321,19 +324,19 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   for (const size_t i : usable) two_skies = two_skies || (options.split_sky && samples[i].sky != samples[i].overcast);
   ChannelFitter fitter(options, samples, n, with_sun);
   std::array<ChannelFit, 3> split_fits{};
-  summary.overcast_share = two_skies ? PooledOvercastShare(&fitter, usable, &split_fits) : 0.0;
-  // Each channel fitted again with the pooled share, starting from its split fit with the two
-  // skies summed.
+  const double overcast = two_skies ? PooledOvercast(&fitter, usable, &split_fits) : 0.0;
+  // Each channel fitted again with the pooled overcast part given, starting from its split fit's
+  // sun and clear sky.
   int unconverged_channels = 0;  // final fits that ran out of IRLS iterations
   std::vector<double> spreads, all_residuals, scratch;
   all_residuals.reserve(3 * n);
   for (int c = 0; c < 3; ++c) {
     const ChannelFit& split = split_fits[static_cast<size_t>(c)];
-    const ChannelFit start{split[0], split[1] + split[2], 0.0};
-    const ChannelFit fit = fitter.Fit(c, false, summary.overcast_share, two_skies ? &start : nullptr, usable);
+    const ChannelFit start{split[0], split[1], 0.0};
+    const ChannelFit fit = fitter.Fit(c, false, overcast, two_skies ? &start : nullptr, usable);
     unconverged_channels += fitter.converged() ? 0 : 1;
     summary.light.sun_rgb[c] = fit[0];
-    summary.light.sky_rgb[c] = fit[1];
+    summary.light.sky_rgb[c] = fit[1] + overcast;
     scratch.clear();
     for (size_t k = 0; k < n; ++k) {
       all_residuals.push_back(std::abs(fitter.relative()[k]));
@@ -342,6 +345,9 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
     spreads.push_back(1.4826 * MedianInPlace(scratch, 0.0));
   }
   summary.residual_spread = *std::max_element(spreads.begin(), spreads.end());
+  // The share that gives that grey part back (SplitLight).
+  const double mean_sky = glm::compAdd(summary.light.sky_rgb) / 3.0;
+  summary.overcast_share = mean_sky > 0.0 ? std::clamp(overcast / mean_sky, 0.0, 1.0) : 0.0;
   size_t inliers = 0;
   for (const double r : all_residuals) inliers += r < 3.0 * options.cauchy_scale ? 1 : 0;
   summary.inlier_share = static_cast<double>(inliers) / static_cast<double>(all_residuals.size());

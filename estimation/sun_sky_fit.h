@@ -67,7 +67,7 @@ enum class SunSkyFitStatus {
 struct SunSkyFitSummary {
   SunSkyFitStatus status = SunSkyFitStatus::kTooFewSamples;
   SunSky light;                 // E_sun (DNI) and E_sky (DHI), RGB, ≥ 0
-  double overcast_share = 0.0;  // E_overcast / E_sky (one share for all channels: clouds are grey)
+  double overcast_share = 0.0;  // the grey overcast part: E_overcast = overcast_share · mean(E_sky) (SplitLight)
   double confidence = 0.0;      // in [0, 1]
   double residual_spread = 0.0; // 1.4826·median |relative residual| over channels (robust σ)
   int sunlit_samples = 0;
