@@ -296,6 +296,7 @@ std::optional<TruthComparison> ReportLighting(const scene::Scene& scene, const s
                               rank.bad_frames, 100 * kBadFrameError, rank.good_frames, 100 * kGoodFrameError));
     }
     report->Figure("lighting/frames", truth->frames);
+    report->Figure("lighting/bad_frames", rank.bad_frames);
     report->Figure("lighting/p90_worst_channel_error", truth->p90_worst_channel_error);
     for (int c = 0; c < 3; ++c) {
       const std::string channel(1, "rgb"[c]);
