@@ -1,6 +1,10 @@
 // Storing and loading the bake: the cache key, multi-layer EXRs, bake.json, albedo.csv, previews.
+#include <unistd.h>
+
 #include <cstdlib>
 #include <fstream>
+#include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
@@ -13,6 +17,7 @@
 #include "base/csv.h"
 #include "base/error.h"
 #include "base/log.h"
+#include "base/version.h"
 #include "capture/response.h"
 #include "report/plot.h"
 #include "scene/hdr_image.h"
@@ -210,6 +215,8 @@ void SaveBake(const SceneBake& bake, const scene::Scene& scene, const BakeOption
                       {"dni_from_map_rgb", Vec(bake.capture_sun.dni_from_map_rgb)},
                       {"disc_texels", bake.capture_sun.disc_texels},
                       {"brightest_offset_deg", bake.capture_sun.brightest_offset_deg}};
+  j["surfaces"] = scene.model.surface_names.size();
+  j["daylit"] = kVersion;
   j["camera"] = {{"width", bake.camera.width}, {"height", bake.camera.height}, {"diffuse_pixels", bake.camera.DiffuseCount()}};
   j["gather"] = {{"min", Vec(bake.gather.min)},
                  {"max", Vec(bake.gather.max)},
@@ -243,6 +250,71 @@ std::optional<SceneBake> LoadBake(const fs::path& dir, const std::string& hash) 
 }
 
 namespace {
+
+[[noreturn]] void Damaged(const std::string& what) { throw std::runtime_error(what); }
+
+// Every value the online stages index with or divide by, as the bake makes them: sizes that
+// agree, indices inside what they index, finite numbers. A cache that fails is baked again
+// (LoadBake), never used: an index past the map read outside it, a NaN point or albedo gave
+// all-zero estimates or a NaN replay with exit 0.
+bool Finite(float v) { return std::isfinite(v); }
+bool Finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+template <typename T>
+void CheckFinite(const std::vector<T>& values, const char* file, const char* what) {
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!Finite(values[i])) Damaged(fmt::format("{}: {} of element {} is not finite", file, what, i));
+  }
+}
+
+void CheckLoadedBake(const SceneBake& bake, const nlohmann::json& j) {
+  const EnvMapMaps& e = bake.env;
+  const size_t texels = static_cast<size_t>(e.width) * static_cast<size_t>(e.height);
+  if (e.width <= 0 || e.width != 2 * e.height) Damaged(fmt::format("env_maps.exr: {}x{} is not a 2:1 map", e.width, e.height));
+  const size_t surfaces = j.value("surfaces", size_t{0});
+  for (const auto* v : {&e.point, &e.normal, &e.irradiance, &e.albedo, &e.radiance}) {
+    if (v->size() != texels) Damaged(fmt::format("env_maps.exr: {} values for {} texels", v->size(), texels));
+  }
+  if (e.sky_visibility.size() != texels || e.surface.size() != texels) Damaged("env_maps.exr: a layer of the wrong size");
+  CheckFinite(e.point, "env_maps.exr", "point"), CheckFinite(e.normal, "env_maps.exr", "normal");
+  CheckFinite(e.irradiance, "env_maps.exr", "E"), CheckFinite(e.albedo, "env_maps.exr", "albedo");
+  CheckFinite(e.radiance, "env_maps.exr", "L"), CheckFinite(e.sky_visibility, "env_maps.exr", "V");
+  for (size_t t = 0; t < texels; ++t) {
+    if (e.surface[t] != kNoSurface && e.surface[t] >= surfaces) Damaged(fmt::format("env_maps.exr: surface {} of texel {}", e.surface[t], t));
+  }
+  const CameraGBuffer& g = bake.camera;
+  const size_t pixels = static_cast<size_t>(g.width) * static_cast<size_t>(g.height);
+  const auto& camera = j["camera"];
+  if (g.width != camera.value("width", -1) || g.height != camera.value("height", -1)) {
+    Damaged(fmt::format("camera_gbuffer.exr: {}x{}, not the camera's", g.width, g.height));
+  }
+  for (const auto* v : {&g.point, &g.normal, &g.albedo}) {
+    if (v->size() != pixels) Damaged(fmt::format("camera_gbuffer.exr: {} values for {} pixels", v->size(), pixels));
+  }
+  if (g.sky_visibility.size() != pixels || g.surface.size() != pixels || g.env_texel.size() != pixels || g.diffuse.size() != pixels) {
+    Damaged("camera_gbuffer.exr: a layer of the wrong size");
+  }
+  CheckFinite(g.point, "camera_gbuffer.exr", "point"), CheckFinite(g.normal, "camera_gbuffer.exr", "normal");
+  CheckFinite(g.albedo, "camera_gbuffer.exr", "albedo"), CheckFinite(g.sky_visibility, "camera_gbuffer.exr", "V");
+  for (size_t p = 0; p < pixels; ++p) {
+    if (g.surface[p] != kNoSurface && g.surface[p] >= surfaces) Damaged(fmt::format("camera_gbuffer.exr: surface {} of pixel {}", g.surface[p], p));
+    if (g.env_texel[p] != kNoSurface && g.env_texel[p] >= texels) Damaged(fmt::format("camera_gbuffer.exr: env texel {} of pixel {}", g.env_texel[p], p));
+  }
+  // The gather table: every entry indexes the env map or its sky layer (bake/parallax.h).
+  const sh::GatherTables& t = bake.gather;
+  if (!t.directions.empty()) {
+    if (t.texel.size() != t.ProbeCount() * t.directions.size()) {
+      Damaged(fmt::format("gather.exr: {} entries for {} probes × {} directions", t.texel.size(), t.ProbeCount(), t.directions.size()));
+    }
+    for (const uint32_t texel : t.texel) {
+      if (texel >= 2 * t.map_texels) Damaged(fmt::format("gather.exr: texel {} outside the {}-texel map and its sky layer", texel, t.map_texels));
+    }
+  }
+  const glm::vec3 sun[3] = {bake.capture_sun.dir, bake.capture_sun.dni_rgb, bake.capture_sun.dni_from_map_rgb};
+  for (const glm::vec3& v : sun) {
+    if (!Finite(v)) Damaged("bake.json: capture_sun is not finite");
+  }
+}
 
 SceneBake ReadBake(const fs::path& dir, const std::string& hash, const nlohmann::json& j) {
   SceneBake bake;
@@ -289,18 +361,6 @@ SceneBake ReadBake(const fs::path& dir, const std::string& hash, const nlohmann:
     bake.gather.directions = SphericalFibonacci(directions);
     bake.gather.texel = std::move(scene::ReadExrChannels(dir / "gather.exr", {}, {"texel"}).uints[0]);
     bake.gather.map_texels = static_cast<size_t>(bake.env.width) * static_cast<size_t>(bake.env.height);
-    // Every entry indexes the env map or its sky layer (bake/parallax.h): a damaged table would
-    // read past them.
-    if (bake.gather.texel.size() != bake.gather.ProbeCount() * bake.gather.directions.size()) {
-      throw std::runtime_error(fmt::format("gather.exr: {} entries for {} probes × {} directions", bake.gather.texel.size(),
-                                           bake.gather.ProbeCount(), bake.gather.directions.size()));
-    }
-    for (const uint32_t t : bake.gather.texel) {
-      if (t >= 2 * bake.gather.map_texels) {
-        throw std::runtime_error(fmt::format("gather.exr: texel {} outside the {}-texel map and its sky layer", t,
-                                             bake.gather.map_texels));
-      }
-    }
   }
   const CsvTable albedo = ReadCsvFile(dir / "albedo.csv");
   for (size_t r = 0; r < albedo.rows.size(); ++r) {
@@ -310,6 +370,10 @@ SceneBake ReadBake(const fs::path& dir, const std::string& hash, const nlohmann:
                                            ParseFiniteDouble(row[3], albedo.Where(r))),
                                  static_cast<size_t>(ParseFiniteDouble(row[4], albedo.Where(r)))});
   }
+  const auto start = std::chrono::steady_clock::now();
+  CheckLoadedBake(bake, j);
+  Log().debug("{}: the cached bake checked in {:.1f} ms", dir.string(),
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   return bake;
 }
 
@@ -322,6 +386,13 @@ SceneBake BakeOrLoad(const scene::Scene& scene, const BakeOptions& options, cons
     return std::move(*cached);
   }
   *loaded = false;
+  // The folder first: a cache that cannot be written is said before the bake, not after it.
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir)) {
+    ThrowInputError("{}: cannot create the cache folder: {}", dir.string(), ec ? ec.message() : "a file is in the way");
+  }
+  if (::access(dir.c_str(), W_OK) != 0) ThrowInputError("{}: the cache folder may not be written to", dir.string());
   SceneBake bake = RunBake(scene, options);
   SaveBake(bake, scene, options, dir);
   return bake;

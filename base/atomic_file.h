@@ -17,8 +17,13 @@ void WriteFileAtomically(const std::filesystem::path& path,
 
 void WriteFileAtomically(const std::filesystem::path& path, std::string_view content);
 
-// A temporary path beside `path` (same folder, so rename is atomic), unique per process and call.
+// A temporary path beside `path` (same folder, so rename is atomic), unique per process and call:
+// "<path>.tmp-<pid>-<n>". Temporaries of `path` that a process no longer running left behind (it
+// was killed before it could rename or remove them) are removed first.
 std::filesystem::path TemporarySibling(const std::filesystem::path& path);
+
+// Removes the "<path>.tmp-<pid>-..." files beside `path` whose process <pid> is gone.
+void RemoveStaleTemporaries(const std::filesystem::path& path);
 
 // Renames `from` to `to`, replacing it; throws InputError naming both on failure.
 void CommitTemporary(const std::filesystem::path& from, const std::filesystem::path& to);

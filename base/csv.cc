@@ -146,7 +146,7 @@ bool TryParseFiniteDouble(std::string_view text, double* value) {
 double ParseFiniteDouble(std::string_view text, std::string_view where) {
   double value = 0.0;
   if (!TryParseFiniteDouble(text, &value)) {
-    ThrowInputError("{}: '{}' is not a finite number", where, Trim(text));
+    ThrowInputError("{}: '{}' is not a finite number", where, Excerpt(Trim(text)));
   }
   return value;
 }

@@ -5,6 +5,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -17,6 +18,13 @@ class InputError : public std::runtime_error {
  public:
   explicit InputError(const std::string& message) : std::runtime_error(message) {}
 };
+
+// Text from the user's input as an error quotes it: at most `most` characters, then "…" and how
+// long it was (a 5 MB token is not echoed whole).
+inline std::string Excerpt(std::string_view text, size_t most = 60) {
+  if (text.size() <= most) return std::string(text);
+  return fmt::format("{}… ({} characters)", text.substr(0, most), text.size());
+}
 
 template <typename... Args>
 [[noreturn]] void ThrowInputError(fmt::format_string<Args...> format, Args&&... args) {

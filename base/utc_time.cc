@@ -147,7 +147,7 @@ UtcTime ParseUtcTime(std::string_view text, std::string_view where) {
   UtcTime utc;
   std::string why;
   if (!TryParseUtcTime(text, &utc, &why)) {
-    ThrowInputError("{}: {} ('{}')", where, why, text);
+    ThrowInputError("{}: {} ('{}')", where, why, Excerpt(text));
   }
   return utc;
 }

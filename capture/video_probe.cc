@@ -6,11 +6,12 @@
 #include <opencv2/videoio.hpp>
 
 #include "base/error.h"
+#include "base/files.h"
 
 namespace daylit::capture {
 
 VideoInfo ProbeVideo(const std::filesystem::path& path) {
-  if (!std::filesystem::is_regular_file(path)) ThrowInputError("{}: no such file", path.string());
+  RequireRegularFile(path);
   cv::VideoCapture video(path.string(), cv::CAP_FFMPEG);
   if (!video.isOpened()) ThrowInputError("{}: cannot open as a video (FFmpeg)", path.string());
   VideoInfo info;

@@ -102,7 +102,7 @@ namespace {
 class ChannelFitter {
  public:
   ChannelFitter(const SunSkyFitOptions& options, const std::vector<Sample>& samples, size_t count, bool with_sun)
-      : options_(options), samples_(samples), with_sun_(with_sun), y_(count), w_(count), relative_(count), offset_(count),
+      : options_(options), samples_(samples), with_sun_(with_sun), y_(count), w_(count), relative_(count), offset_(count), rest_(count),
         x_{std::vector<double>(count), std::vector<double>(count), std::vector<double>(count)},
         stride_(std::max<size_t>(1, count / 2000)) {
     scratch_.reserve(count);
@@ -150,14 +150,14 @@ class ChannelFitter {
       x_[1][k] = a * s.sky[c];
       x_[2][k] = split ? a * s.overcast[c] : 0.0;
       offset_[k] = split ? 0.0 : a * overcast * s.overcast[c];
+      rest_[k] = y_[k] - offset_[k];
     }
   }
 
   // The weighted normal equations of the samples with the weights in w_ (all three regressors;
   // an unused one is zero) for the radiance less its known part, vectorised by Eigen.
   NormalEquations Equations() {
-    const Eigen::ArrayXd ey = Column(y_) - Column(offset_);
-    const Eigen::Map<Eigen::ArrayXd> ex0 = Column(x_[0]), ex1 = Column(x_[1]), ex2 = Column(x_[2]);
+    const Eigen::Map<Eigen::ArrayXd> ey = Column(rest_), ex0 = Column(x_[0]), ex1 = Column(x_[1]), ex2 = Column(x_[2]);
     const Eigen::Map<Eigen::ArrayXd> ew = Column(w_);
     NormalEquations eq;
     const Eigen::ArrayXd w0 = ew * ex0, w1 = ew * ex1, w2 = ew * ex2;
@@ -175,7 +175,7 @@ class ChannelFitter {
     ChannelFit fit{0.0, 0.0, 0.0};
     scratch_.clear();
     for (size_t k = 0; k < m_; k += stride_) {
-      if (!samples_[rows[k]].sunlit && x_[1][k] > 0.0) scratch_.push_back((y_[k] - offset_[k]) / x_[1][k]);
+      if (!samples_[rows[k]].sunlit && x_[1][k] > 0.0) scratch_.push_back(rest_[k] / x_[1][k]);
     }
     fit[1] = MedianInPlace(scratch_, 0.0);
     if (scratch_.empty()) {
@@ -184,7 +184,7 @@ class ChannelFitter {
     }
     scratch_.clear();
     for (size_t k = 0; k < m_; k += stride_) {
-      if (IsSunlit(samples_[rows[k]], options_)) scratch_.push_back((y_[k] - offset_[k] - x_[1][k] * fit[1]) / x_[0][k]);
+      if (IsSunlit(samples_[rows[k]], options_)) scratch_.push_back((rest_[k] - x_[1][k] * fit[1]) / x_[0][k]);
     }
     if (with_sun_ && !scratch_.empty()) fit[0] = std::max(0.0, MedianInPlace(scratch_, 0.0));
     return fit;
@@ -223,7 +223,7 @@ class ChannelFitter {
   const SunSkyFitOptions& options_;
   const std::vector<Sample>& samples_;
   const bool with_sun_;
-  std::vector<double> y_, w_, relative_, scratch_, offset_;
+  std::vector<double> y_, w_, relative_, scratch_, offset_, rest_;  // rest_: y_ less offset_
   std::array<std::vector<double>, 3> x_;
   const size_t stride_;
   size_t m_ = 0;
@@ -254,13 +254,14 @@ void SplitShares(const SunSkyFitOptions& options, const std::vector<Sample>& sam
                  SunSkyFitSummary* summary) {
   glm::dvec3 sun_lit(0.0), all_lit(0.0), sky_shadow(0.0), all_shadow(0.0);
   // The model's two parts of each sample's predicted radiance: PredictedRadiance with one term.
-  const SunSky sun_only{summary->light.sun_rgb, glm::dvec3(0.0)}, sky_only{glm::dvec3(0.0), summary->light.sky_rgb};
+  const LightParts all = SplitLight(summary->light, summary->overcast_share);
+  const LightParts sun_only{all.sun, glm::vec3(0.0f), glm::vec3(0.0f)}, sky_only{glm::vec3(0.0f), all.clear, all.overcast};
   for (const size_t i : usable) {
     const Sample& s = samples[i];
     const bool lit = IsSunlit(s, options);
     if (!lit && s.sunlit) continue;  // grazing sun: neither stratum
-    const glm::dvec3 sun(PredictedRadiance(s, sun_only, summary->overcast_share));
-    const glm::dvec3 sky(PredictedRadiance(s, sky_only, summary->overcast_share));
+    const glm::dvec3 sun(PredictedRadiance(s, sun_only));
+    const glm::dvec3 sky(PredictedRadiance(s, sky_only));
     // Each sample weighs as its share (a mean of shares, not a share of sums: bright points do
     // not outvote dim ones).
     const glm::dvec3 total = glm::max(sun + sky, glm::dvec3(1e-30));
@@ -295,9 +296,12 @@ double Confidence(const SunSkyFitOptions& options, const SunSkyFitSummary& summa
 
 }  // namespace
 
+glm::vec3 PredictedRadiance(const Sample& s, const LightParts& light) {
+  return s.albedo * glm::one_over_pi<float>() * Irradiance(light, s.sun, s.sky, s.overcast);
+}
+
 glm::vec3 PredictedRadiance(const Sample& s, const SunSky& light, double overcast_share) {
-  const LightParts e = SplitLight(light, overcast_share);
-  return s.albedo * glm::one_over_pi<float>() * Irradiance(e, s.sun, s.sky, s.overcast);
+  return PredictedRadiance(s, SplitLight(light, overcast_share));
 }
 
 SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sample>& samples) {

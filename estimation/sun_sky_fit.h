@@ -36,8 +36,11 @@ struct Sample {
 };
 
 // What the model predicts for `s` under `light` with the overcast share `overcast_share`:
-// ρ/π · (T_sun·E_sun + ((1 − o)·T_clear + o·T_overcast)·E_sky), radiance units.
+// ρ/π · (T_sun·E_sun + T_clear·E_clear + T_overcast·E_overcast) with the parts of SplitLight,
+// radiance units.
 glm::vec3 PredictedRadiance(const Sample& s, const SunSky& light, double overcast_share);
+// The same with the light already split into its parts (SplitLight).
+glm::vec3 PredictedRadiance(const Sample& s, const LightParts& light);
 
 struct SunSkyFitOptions {
   double cauchy_scale = 0.1;        // relative residual at which a sample's weight halves

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/atomic_file.h"
+#include "base/version.h"
 
 namespace daylit::evaluation {
 
@@ -30,7 +31,9 @@ std::string RunReport::FiguresJson() const {
   return json.dump(2) + "\n";
 }
 
-void RunReport::Write(const std::filesystem::path& file) const { WriteFileAtomically(file, text_); }
+void RunReport::Write(const std::filesystem::path& file) const {
+  WriteFileAtomically(file, fmt::format("daylit {}\n{}", kVersion, text_));
+}
 
 void RunReport::WriteFigures(const std::filesystem::path& file) const { WriteFileAtomically(file, FiguresJson()); }
 

@@ -23,6 +23,7 @@ class RunReport {
   const std::string& text() const { return text_; }
   // The figures as one JSON object, keys sorted.
   std::string FiguresJson() const;
+  // The text with the build's version (base/version.h) on its first line.
   void Write(const std::filesystem::path& file) const;
   void WriteFigures(const std::filesystem::path& file) const;
 

@@ -9,11 +9,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 
 #include <opencv2/imgcodecs.hpp>
 
 #include "base/atomic_file.h"
 #include "base/error.h"
+#include "base/files.h"
 
 namespace daylit::scene {
 namespace {
@@ -31,10 +34,14 @@ Imf::PixelType ToImf(ExrPixelType type) {
 ExrChannels ReadPlanes(const std::filesystem::path& path, const std::vector<std::string>& names,
                        const std::vector<std::string>& uint_names) {
   ExrChannels out;
+  // Half floats at least (2 bytes) for each channel asked for.
+  CheckExrClaimedSize(path, 2 * static_cast<int64_t>(names.size() + uint_names.size()));
   Imf::InputFile file(path.c_str());
   const Imath::Box2i window = file.header().dataWindow();
-  out.width = window.max.x - window.min.x + 1;
-  out.height = window.max.y - window.min.y + 1;
+  const int64_t width = int64_t{window.max.x} - window.min.x + 1, height = int64_t{window.max.y} - window.min.y + 1;
+  CheckClaimedSize(path, width, height, 2 * static_cast<int64_t>(names.size() + uint_names.size()));
+  out.width = static_cast<int>(width);
+  out.height = static_cast<int>(height);
   const size_t count = static_cast<size_t>(out.width) * out.height;
   // Slices are addressed in data-window coordinates, so offset each base by the window's origin.
   const ptrdiff_t origin = static_cast<ptrdiff_t>(window.min.y) * out.width + window.min.x;
@@ -85,9 +92,73 @@ HdrImage ReadExrRgb(const std::filesystem::path& path) {
 
 }  // namespace
 
+void CheckExrClaimedSize(const std::filesystem::path& path, int64_t bytes_per_pixel) {
+  // The header as OpenEXR 2.0 lays it out: magic 76 2f 31 01, a version word, then attributes
+  // "name\0type\0" + int32 size + value, up to an empty name. The data window is a box2i (four
+  // int32: x min, y min, x max, y max). Read here, before OpenEXR builds anything from it.
+  std::ifstream in(path, std::ios::binary);
+  char head[8];
+  if (!in.read(head, 8) || static_cast<unsigned char>(head[0]) != 0x76 || head[1] != 0x2f || head[2] != 0x31 || head[3] != 0x01) {
+    return;  // not an OpenEXR file: OpenEXR says so
+  }
+  for (int attributes = 0; attributes < 1000; ++attributes) {
+    std::string name, type;
+    if (!std::getline(in, name, '\0') || name.empty() || name.size() > 255) return;
+    if (!std::getline(in, type, '\0') || type.size() > 255) return;
+    int32_t size = 0;
+    if (!in.read(reinterpret_cast<char*>(&size), 4) || size < 0 || size > (1 << 24)) return;
+    if (name == "dataWindow" && type == "box2i" && size == 16) {
+      int32_t box[4];
+      if (!in.read(reinterpret_cast<char*>(box), 16)) return;
+      CheckClaimedSize(path, int64_t{box[2]} - box[0] + 1, int64_t{box[3]} - box[1] + 1, bytes_per_pixel);
+      return;
+    }
+    in.seekg(size, std::ios::cur);
+  }
+}
+
+void CheckClaimedSize(const std::filesystem::path& path, int64_t width, int64_t height, int64_t bytes_per_pixel) {
+  if (width <= 0 || height <= 0) ThrowInputError("{}: its header gives an empty image ({}x{})", path.string(), width, height);
+  if (width > kMostImagePixels / height) {
+    ThrowInputError("{}: its header claims {}x{} pixels, over daylit's limit of 16384x8192", path.string(), width, height);
+  }
+  constexpr int64_t kMostCompression = 1032;
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(path, ec);
+  const int64_t least = width * height * bytes_per_pixel / kMostCompression;
+  if (!ec && static_cast<int64_t>(bytes) < least) {
+    ThrowInputError("{}: its header claims {}x{} pixels, which no compression fits in its {} bytes: truncated or damaged",
+                    path.string(), width, height, bytes);
+  }
+}
+
+void ReadRadianceSize(const std::filesystem::path& path, int* width, int* height) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) ThrowInputError("{}: cannot be opened", path.string());
+  // Header lines ("#?RADIANCE", "FORMAT=...", ...) up to a blank one, then the resolution line.
+  std::string line;
+  bool blank = false;
+  for (int lines = 0; lines < 64 && std::getline(in, line); ++lines) {
+    if (line.size() > 512) break;
+    if (blank) {
+      int h = 0, w = 0;
+      char y_sign = 0, x_sign = 0;
+      if (std::sscanf(line.c_str(), "%cY %d %cX %d", &y_sign, &h, &x_sign, &w) == 4 && (y_sign == '-' || y_sign == '+') &&
+          (x_sign == '-' || x_sign == '+')) {
+        *width = w, *height = h;
+        return;
+      }
+      break;
+    }
+    blank = line.empty();
+  }
+  ThrowInputError("{}: not a Radiance HDR file (no resolution line after its header)", path.string());
+}
+
 HdrImage ReadHdrImage(const std::filesystem::path& path) {
-  if (!std::filesystem::is_regular_file(path)) ThrowInputError("{}: no such file", path.string());
+  RequireRegularFile(path);
   if (path.extension() == ".exr") {
+    CheckExrClaimedSize(path, 2);
     try {
       return ReadExrRgb(path);
     } catch (const InputError&) {
@@ -96,6 +167,9 @@ HdrImage ReadHdrImage(const std::filesystem::path& path) {
       ThrowInputError("{}: not a readable OpenEXR file ({})", path.string(), e.what());
     }
   }
+  int width = 0, height = 0;
+  ReadRadianceSize(path, &width, &height);
+  CheckClaimedSize(path, width, height, 4);  // RGBE: 4 bytes a pixel
   const cv::Mat bgr = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
   if (bgr.empty() || bgr.depth() != CV_32F || bgr.channels() != 3) {
     ThrowInputError("{}: not a readable Radiance HDR (or OpenEXR) image", path.string());

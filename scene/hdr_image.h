@@ -16,8 +16,25 @@ inline float Luminance(const float* rgb) { return 0.2126f * rgb[0] + 0.7152f * r
 
 
 // Reads R, G, B (or Y, as grey) as 32-bit floats from an OpenEXR file, or decodes a Radiance
-// .hdr with OpenCV. Throws InputError naming the file when it cannot be read.
+// .hdr with OpenCV. Throws InputError naming the file when it cannot be read. Before anything is
+// allocated, the size its header claims is checked (CheckClaimedSize).
 HdrImage ReadHdrImage(const std::filesystem::path& path);
+
+// The most pixels an image daylit reads may claim: a 16384×8192 map (1.6 GB as float RGB).
+inline constexpr int64_t kMostImagePixels = int64_t{16384} * 8192;
+// Throws InputError naming `path` when its header's `width` × `height` is empty, over
+// kMostImagePixels, or more than the file's bytes can hold: no compression an EXR or a Radiance
+// file uses packs more than 1032 bytes of samples (deflate's limit) into one, and every pixel has
+// at least `bytes_per_pixel` of them.
+void CheckClaimedSize(const std::filesystem::path& path, int64_t width, int64_t height, int64_t bytes_per_pixel);
+
+// CheckClaimedSize on an OpenEXR file's data window, read from its header by hand before OpenEXR
+// builds anything from it (nothing when the file is not OpenEXR: OpenEXR then says so).
+void CheckExrClaimedSize(const std::filesystem::path& path, int64_t bytes_per_pixel);
+
+// The width and height a Radiance .hdr's header gives ("-Y H +X W" after the header lines),
+// without decoding it. Throws InputError naming the file when there is none.
+void ReadRadianceSize(const std::filesystem::path& path, int* width, int* height);
 
 // Checks an environment map: 2:1, then CheckLightProbe. Throws InputError naming the file.
 void CheckEnvMap(const HdrImage& image, const std::string& name);

@@ -28,7 +28,7 @@ void CheckFaceLine(const std::filesystem::path& path, int line, std::string_view
     const auto [ptr, ec] = std::from_chars(index_text.data(), index_text.data() + index_text.size(), index);
     if (index_text.empty() || ec != std::errc() || ptr != index_text.data() + index_text.size() || index == 0) {
       ThrowInputError("{}:{}: face vertex '{}' is not a vertex index (1-based, or negative from the last)",
-                      path.string(), line, token);
+                      path.string(), line, Excerpt(token));
     }
     if (index < 0 && static_cast<size_t>(-index) > vertices_so_far) {
       ThrowInputError("{}:{}: face vertex {} reaches before the first vertex ({} defined so far)", path.string(),
@@ -70,7 +70,7 @@ void CheckVertexLines(const std::filesystem::path& path, std::string_view text) 
       if (token.empty() || ec != std::errc() || ptr != token.data() + token.size() ||
           !std::isfinite(value)) {
         ThrowInputError("{}:{}: vertex coordinate {} is not a finite number ('{}')",
-                        path.string(), line, "xyz"[k], token);
+                        path.string(), line, "xyz"[k], Excerpt(token));
       }
       l.remove_prefix(n);
     }

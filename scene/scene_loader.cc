@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "base/error.h"
+#include "base/files.h"
 #include "base/log.h"
 #include "base/statistics.h"
 #include "capture/frame_source.h"
@@ -41,7 +42,9 @@ fs::path Resolve(const Scene& scene, const JsonField& field, const std::string& 
 fs::path RequireFile(const Scene& scene, const JsonField& field) {
   const std::string relative = field.String();
   const fs::path path = Resolve(scene, field, relative);
-  if (!fs::is_regular_file(path)) field.Fail(fmt::format("file '{}' not found", path.string()));
+  const std::string why = WhyNotAFile(path);
+  if (why == "no such file") field.Fail(fmt::format("file '{}' not found", path.string()));
+  if (!why.empty()) field.Fail(fmt::format("'{}' {}", path.string(), why));
   return path;
 }
 
@@ -67,6 +70,9 @@ void LoadModelAndSurfaces(const JsonField& root, Scene* scene) {
     root.Get("diffuse_surfaces");  // throws "missing": one of the two is needed
   }
   if (!globs) return;
+  if (globs->Elements().empty() && !scene->diffuse_mask) {
+    globs->Fail("empty: name at least one surface whose pixels the estimation may use (or give diffuse_mask)");
+  }
   for (const JsonField& g : globs->Elements()) {
     const std::string glob = g.String();
     const std::vector<int> matched = scene->model.MatchSurfaces(glob);
@@ -430,9 +436,12 @@ void AllowPathsOutsideRecording(bool allow) { allow_paths_outside = allow; }
 
 Scene LoadScene(const fs::path& path) {
   Scene scene;
-  if (!fs::exists(path)) ThrowInputError("{}: no such file or folder", path.string());
-  scene.file = fs::is_directory(path) ? path / "scene.json" : path;
-  if (!fs::is_regular_file(scene.file)) ThrowInputError("{}: no such file", scene.file.string());
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (status.type() == fs::file_type::not_found) ThrowInputError("{}: no such file or folder", path.string());
+  if (ec) ThrowInputError("{}: {}", path.string(), ec.message());
+  scene.file = fs::is_directory(status) ? path / "scene.json" : path;
+  RequireRegularFile(scene.file);
   scene.folder = scene.file.parent_path();
   const nlohmann::json json = ReadJsonFile(scene.file);
   const JsonField root(json, scene.file.string(), "");

@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "base/error.h"
+
 namespace daylit::sunmodel {
 
 std::string EarthOrientation::Check(std::string_view delta_t_name, std::string_view dut1_name) const {
@@ -21,7 +23,6 @@ std::string EarthOrientation::Check(std::string_view delta_t_name, std::string_v
 namespace {
 
 constexpr double kSecondsPerDay = 86400.0;
-constexpr double kTtMinusTai = 32.184;
 
 // UTC (and ERFA's TAI − UTC table) starts in 1960. Past the table's end eraDat keeps the last
 // TAI − UTC and returns status +1 ("dubious year"), which we accept.
@@ -75,29 +76,45 @@ double ModelDeltaT(double y) {
 
 TimeScales ResolveTimeScales(const UtcTime& utc, const EarthOrientation& orientation) {
   TimeScales ts;
-  const int whole_second = static_cast<int>(std::floor(utc.second));
-  const double fraction = utc.second - whole_second;
-  double u1 = 0.0, u2 = 0.0;
-  // "UTC" makes ERFA give the leap-second day its 86401 s; before 1960 the status is +1 and the
-  // date is taken as plain UT, which is what the input means there.
-  eraDtf2d("UTC", utc.year, utc.month, utc.day, utc.hour, utc.minute, whole_second, &u1, &u2);
-  u2 += fraction / kSecondsPerDay;
   const double dut1 = orientation.dut1_s.value_or(0.0);
-  ts.ut1_jd1 = u1;
-  ts.ut1_jd2 = u2 + dut1 / kSecondsPerDay;
-
-  if (orientation.delta_t_s) {
-    ts.source = DeltaTSource::kGiven;
-    ts.delta_t_s = *orientation.delta_t_s;
-  } else if (utc.year >= kFirstUtcYear) {
+  // ERFA's quasi-JD for UTC: a day that ends with a leap second has 86 401 s, and only then may
+  // the seconds reach 60.x at 23:59 (else status +2, "time after end of day", +3 with a dubious
+  // year). Before 1960 (status +1) the date is plain UT.
+  double u1 = 0.0, u2 = 0.0;
+  const int status = eraDtf2d("UTC", utc.year, utc.month, utc.day, utc.hour, utc.minute, utc.second, &u1, &u2);
+  if (status >= 2) {
+    ThrowInputError("{}: no leap second ends that UTC day, so its last minute has 60 seconds (IERS table in ERFA)",
+                    FormatUtcTime(utc));
+  }
+  if (status < 0) ThrowInputError("{}: not a calendar date ERFA accepts (status {})", FormatUtcTime(utc), status);
+  if (utc.year >= kFirstUtcYear) {
+    // UT1 = UTC + DUT1 and TT = TAI + 32.184 s, both through ERFA from the quasi-JD, which
+    // takes the leap second into account. Reading the quasi-JD as a plain Julian date put an
+    // instant late on such a day up to 1 s late (0.92 s at 22:11: 0.004° of sun).
+    if (eraUtcut1(u1, u2, dut1, &ts.ut1_jd1, &ts.ut1_jd2) < 0) {
+      ThrowInputError("{}: ERFA cannot take it to UT1", FormatUtcTime(utc));
+    }
+    if (orientation.delta_t_s) {
+      ts.source = DeltaTSource::kGiven;
+      ts.delta_t_s = *orientation.delta_t_s;
+      ts.tt_jd1 = ts.ut1_jd1, ts.tt_jd2 = ts.ut1_jd2 + ts.delta_t_s / kSecondsPerDay;
+      return ts;
+    }
     // TT − UTC is exact from the leap-second table; only UT1 − UTC is unknown, and leap
     // seconds keep it within 0.9 s.
     double tai1 = 0.0, tai2 = 0.0;
     eraUtctai(u1, u2, &tai1, &tai2);
-    const double tt_minus_utc_s = ((tai1 - u1) + (tai2 - u2)) * kSecondsPerDay + kTtMinusTai;
+    eraTaitt(tai1, tai2, &ts.tt_jd1, &ts.tt_jd2);
     ts.source = DeltaTSource::kLeapSeconds;
-    ts.delta_t_s = tt_minus_utc_s - dut1;
+    ts.delta_t_s = ((ts.tt_jd1 - ts.ut1_jd1) + (ts.tt_jd2 - ts.ut1_jd2)) * kSecondsPerDay;
     ts.ut1_uncertainty_s = orientation.dut1_s ? 0.0 : 0.9;
+    return ts;
+  }
+  ts.ut1_jd1 = u1;
+  ts.ut1_jd2 = u2 + dut1 / kSecondsPerDay;
+  if (orientation.delta_t_s) {
+    ts.source = DeltaTSource::kGiven;
+    ts.delta_t_s = *orientation.delta_t_s;
   } else {
     const double decimal_year = utc.year + (utc.month - 0.5) / 12.0;
     ts.delta_t_s = ModelDeltaT(decimal_year);

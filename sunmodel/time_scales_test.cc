@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "base/error.h"
+
 namespace daylit::sunmodel {
 namespace {
 
@@ -28,6 +30,33 @@ TEST(TimeScalesTest, LeapSecondTableGivesTtMinusUtcExactly) {
   EXPECT_NEAR(with_dut1.delta_t_s, 69.184 - 0.25, 1e-6);
   EXPECT_NEAR(DaysBetween(with_dut1.tt_jd1, with_dut1.tt_jd2, ts.tt_jd1, ts.tt_jd2), 0.0, 1e-11);
   EXPECT_DOUBLE_EQ(with_dut1.ut1_uncertainty_s, 0.0);
+}
+
+// Days that end with a leap second have 86 401 s; an instant on one is where it is, not stretched
+// over the longer day. Julian dates worked out by hand: 1990-12-31 0h UT is JD 2448256.5 and
+// 1995-12-31 0h JD 2450082.5 (Meeus, ch. 7); TAI − UTC is 25 s on the first and 29 s on the
+// second, one more from the next day (IERS Bulletin C), so TT − UTC = TAI − UTC + 32.184 s.
+TEST(TimeScalesTest, LeapSecondDaysKeepTheirInstants) {
+  struct Case {
+    const char* utc;
+    double jd0;         // 0h UT of the date (or of the next day)
+    double seconds;     // UT1 − jd0 in seconds, with UT1 − UTC = 0
+    double tt_minus_ut1;
+  };
+  for (const Case& c : {Case{"1990-12-31T22:11:00Z", 2448256.5, 79860.0, 57.184},
+                        Case{"1995-12-31T12:00:00Z", 2450082.5, 43200.0, 61.184},
+                        Case{"1995-12-31T23:59:59.5Z", 2450082.5, 86399.5, 61.184},
+                        // The leap second itself: TAI 1996-01-01T00:00:29.5, less that day's
+                        // 29 s of TAI − UTC: UT1 half a second into 1996, TT 61.184 s later.
+                        Case{"1995-12-31T23:59:60.5Z", 2450083.5, 0.5, 61.184},
+                        Case{"1996-01-01T00:00:00.5Z", 2450083.5, 0.5, 62.184}}) {
+    const TimeScales ts = ResolveTimeScales(ParseUtcTime(c.utc, "t"), {std::nullopt, 0.0});
+    EXPECT_NEAR(DaysBetween(ts.ut1_jd1, ts.ut1_jd2, c.jd0, 0.0) * 86400.0, c.seconds, 1e-4) << c.utc;
+    EXPECT_NEAR(ts.delta_t_s, c.tt_minus_ut1, 1e-4) << c.utc;
+  }
+  // A 61st second where no leap second is: said, not taken.
+  EXPECT_THROW(ResolveTimeScales(ParseUtcTime("2023-03-01T23:59:60Z", "t"), {}), InputError);
+  EXPECT_NO_THROW(ResolveTimeScales(ParseUtcTime("2016-12-31T23:59:60.5Z", "t"), {}));
 }
 
 TEST(TimeScalesTest, ModelAgreesWithObservedDeltaT) {

@@ -1,8 +1,12 @@
 // The `daylit` binary as a user runs it: exit codes, one-line errors on stderr, results on stdout.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <array>
 #include <cstdio>
@@ -636,6 +640,69 @@ TEST(CliTest, RelightOfAFrameWithoutAnEstimate) {
   EXPECT_TRUE(fs::is_regular_file(rec.dir / "r.mp4"));
 }
 
+// A process id that no process has now (a child that has ended and been reaped).
+pid_t DeadPid() {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  return child;
+}
+
+// SIGTERM (as a service manager or `timeout` sends it) ends a replay as Ctrl-C does: after the
+// frame at hand, with a complete video and its report, exit 0. A temporary that a killed run
+// left beside the output is removed by the next run, and none is left by this one.
+TEST(CliTest, SigtermEndsAReplayWithCompleteOutputsAndNoTemporaries) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_term_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path stale = dir / ("r.mp4.tmp-" + std::to_string(DeadPid()) + "-0.mp4");
+  WriteFileAtomically(stale, "half a video");
+  const fs::path err = dir / "stderr.txt";
+  const pid_t child = ::fork();
+  if (child == 0) {
+    const int fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 2);
+    const std::string cache = DAYLIT_BINARY_DIR "/test-cache/courtyard-a", out = (dir / "r.mp4").string();
+    ::execl(DAYLIT_BINARY_DIR "/bin/daylit", "daylit", "replay", kRecording.c_str(), "--cache", cache.c_str(), "--out",
+            out.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // Once frames are going out (the progress line says fps), stop it.
+  const auto progress = [&] { return fs::exists(err) ? ReadTextFile(err) : std::string(); };
+  for (int i = 0; i < 600 && progress().find(" fps") == std::string::npos; ++i) ::usleep(100000);
+  ASSERT_NE(progress().find(" fps"), std::string::npos) << progress();
+  ::kill(child, SIGTERM);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "ended by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  EXPECT_EQ(WEXITSTATUS(status), 0) << ReadTextFile(err);
+  capture::VideoDecoder video(dir / "r.mp4");
+  cv::Mat frame;
+  int frames = 0;
+  while (video.Next(&frame)) ++frames;
+  EXPECT_GT(frames, 0);
+  EXPECT_LT(frames, 600);  // stopped early
+  EXPECT_EQ(ReadCsvFile(dir / "estimates.csv").rows.size(), static_cast<size_t>(frames));
+  EXPECT_TRUE(fs::is_regular_file(dir / "report.txt"));
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
+  }
+  fs::remove_all(dir);
+}
+
+// --version; -q and -v after the command as before it.
+TEST(CliTest, VersionAndVerbosityAnywhere) {
+  const CliRun version = Daylit("--version");
+  EXPECT_EQ(version.exit_code, 0);
+  EXPECT_EQ(version.out.rfind("daylit 0.", 0), 0u) << version.out;
+  const CliRun quiet_after = Daylit("sunpos --time 2026-06-21T10:00:00Z --lat 57 --lon 9 -v");
+  EXPECT_EQ(quiet_after.exit_code, 0) << quiet_after.err;
+  const CliRun quiet = Daylit("info " + kRecording + " -q");
+  EXPECT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
+}
+
 TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
   scene::testing::SceneSandbox sandbox("cli");
   sandbox.WriteText("broken.json", "{\"format\": \"daylit-recording/1\",");
@@ -643,6 +710,36 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
   sandbox.json()["model"]["file"] = "nan.obj";
   const fs::path nan_scene = sandbox.Write();
   const std::string dir = sandbox.dir().string();
+  // An env map whose header claims far more than its file holds (a real 64×32 OpenEXR with its
+  // data window rewritten): refused before anything is allocated.
+  const auto claiming = [&](const std::string& name, int width, int height) {
+    const fs::path path = sandbox.dir() / name;
+    const std::vector<float> rgb(64 * 32 * 3, 1.0f);
+    scene::WriteRgbExr(path, 64, 32, rgb.data());
+    std::string bytes = ReadTextFile(path);
+    const size_t at = bytes.find(std::string("dataWindow\0box2i\0", 17));
+    EXPECT_NE(at, std::string::npos);
+    const int32_t box[4] = {0, 0, width - 1, height - 1};
+    bytes.replace(at + 17 + 4, 16, reinterpret_cast<const char*>(box), 16);  // after the attribute's size
+    WriteFileAtomically(path, bytes);
+    return path;
+  };
+  claiming("huge.exr", 65536, 32768);
+  claiming("thin.exr", 8192, 4096);
+  scene::testing::SceneSandbox hostile("cli_huge");
+  hostile.json()["envmap"]["file"] = "huge.exr";
+  fs::copy_file(sandbox.dir() / "huge.exr", hostile.dir() / "huge.exr", fs::copy_options::overwrite_existing);
+  const fs::path huge = hostile.Write();
+  fs::create_symlink(sandbox.dir() / "loop", sandbox.dir() / "loop");
+  ::mkfifo((sandbox.dir() / "fifo").c_str(), 0644);
+  // An OBJ whose coordinate is a 5 MB token: the error quotes 60 characters of it.
+  scene::testing::SceneSandbox long_obj("cli_long_token");
+  long_obj.WriteText("long.obj", "o ground\nv " + std::string(5 << 20, '7') + "x 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n");
+  long_obj.json()["model"]["file"] = "long.obj";
+  const fs::path long_token = long_obj.Write();
+  scene::testing::SceneSandbox empty("cli_no_surfaces");
+  empty.json()["diffuse_surfaces"] = nlohmann::json::array();
+  const fs::path no_surfaces = empty.Write();
   scene::testing::SceneSandbox live("cli_live");
   live.json()["frames"] = {{"device", "/dev/video-daylit-absent"}, {"fps", 30}};
   const fs::path live_scene = live.Write();
@@ -715,12 +812,37 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"relight-env " + kRecording + " --frame 0 --out " + dir + "/e.png", "--out: " + dir + "/e.png must end in .exr"},
       {"sunpos --time 2026-06-21T10:00:00Z --lat 50 --lon 10 --dut1 5", "--dut1: 5 s is not UT1 − UTC"},
       {"sunpos --time 2026-06-21T10:00:00Z --lat 50 --lon 10 --delta-t 1e300", "--delta-t: 1e+300 s is outside [-1000, 20000]"},
+      {"sunpos --time 2023-03-01T23:59:60Z --lat 50 --lon 10", "no leap second ends that UTC day"},
+      // Paths that are not what they must be (issue 21): bad input, exit 2, with the path.
+      {"info " + (sandbox.dir() / "loop").string(), "loop: Too many levels of symbolic links"},
+      {"info /dev/zero", "/dev/zero: is not a regular file"},
+      {"info " + (sandbox.dir() / "fifo").string(), "fifo: is not a regular file"},
+      {"lights " + kProbe + " --out " + dir + "/broken.json", "broken.json"},
+      {"estimate " + kRecording + " --out " + dir, "--out: " + dir + " is a folder, not a file to write"},
+      {"estimate " + kRecording + " --out /proc/y.csv", "--out: /proc: may not be written to"},
+      {"estimate " + kRecording + " --cache /proc/daylit-cache", "/proc/daylit-cache: cannot create the cache folder"},
+      {"render " + kRecording + " --frame 300 --out /proc/f.png", "--out: /proc: may not be written to"},
+      {"estimate " + kRecording + " --frames 0", "--frames: 0 is not a number of frames"},
+      {"info " + long_token.string(), "vertex coordinate x is not a finite number"},
+      {"info " + no_surfaces.string(), "diffuse_surfaces: empty"},
+      // The command line itself.
+      {"frobnicate", "'frobnicate' is not a daylit command"},
+      {"lights " + (sandbox.dir() / "huge.exr").string() + " --out " + dir + "/l",
+       "huge.exr: its header claims 65536x32768 pixels, over daylit's limit of 16384x8192"},
+      {"lights " + (sandbox.dir() / "thin.exr").string() + " --out " + dir + "/l",
+       "thin.exr: its header claims 8192x4096 pixels, which no compression fits in its"},
   };
+  // info prints as it goes: the recording's lines, then the env map's error.
+  const CliRun info = Daylit("info " + huge.string());
+  EXPECT_EQ(info.exit_code, 2);
+  EXPECT_NE(info.err.find("huge.exr: its header claims 65536x32768 pixels, over daylit's limit of 16384x8192"), std::string::npos)
+      << info.err;
   for (const BadCall& call : calls) {
     const CliRun run = Daylit(call.args);  // NOLINT
     EXPECT_EQ(run.exit_code, 2) << call.args;
-    EXPECT_NE(run.err.find(call.error), std::string::npos) << call.args << "\n" << run.err;
-    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << call.args << "\n" << run.err;
+    EXPECT_NE(run.err.find(call.error), std::string::npos) << call.args << "\n" << run.err.substr(0, 2000);
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << call.args << "\n" << run.err.substr(0, 2000);
+    EXPECT_LT(run.err.size(), 400u) << call.args;  // one line, quoting at most an excerpt
     EXPECT_EQ(run.out, "") << call.args;
   }
 }

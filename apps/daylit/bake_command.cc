@@ -62,8 +62,8 @@ void AddBakeCommand(CLI::App& app) {
   cmd->add_option("--cache", options->cache, "Cache folder (default: $XDG_CACHE_HOME/daylit/<scene name>)");
   cmd->add_flag("--print-albedo", options->print_albedo, "Print each surface's median albedo (CSV) to stdout");
   cmd->add_flag("--force", options->force, "Bake even when the cache is current");
-  cmd->add_option("--rays", options->bake.rays.hemisphere_rays, "Hemisphere rays per point (default 256)");
-  cmd->add_option("--gather-directions", options->bake.gather_directions, "Directions per volume probe (default 512)");
+  cmd->add_option("--rays", options->bake.rays.hemisphere_rays, "Hemisphere rays per point")->capture_default_str();
+  cmd->add_option("--gather-directions", options->bake.gather_directions, "Directions per volume probe")->capture_default_str();
   cmd->callback([options] { RunBakeCommand(*options); });
 }
 

@@ -15,6 +15,7 @@
 #include "apps/daylit/commands.h"
 #include "base/atomic_file.h"
 #include "base/error.h"
+#include "base/files.h"
 #include "base/log.h"
 #include "capture/camera_calibration.h"
 #include "capture/response.h"
@@ -24,7 +25,7 @@ namespace daylit::app {
 namespace {
 
 cv::Mat ReadEightBit(const std::string& file, int flags) {
-  if (!std::filesystem::is_regular_file(file)) ThrowInputError("{}: no such file", file);
+  RequireRegularFile(file);
   const cv::Mat image = cv::imread(file, flags);
   if (image.empty()) ThrowInputError("{}: cannot be decoded as an image", file);
   if (image.depth() != CV_8U) ThrowInputError("{}: not an 8-bit image", file);

@@ -31,11 +31,20 @@ void AddResultsCommand(CLI::App& app);
 // Empty paths (an output not asked for) are skipped.
 void RefuseSharedOutputs(const std::vector<std::pair<std::string, std::filesystem::path>>& outputs);
 
+// Throws InputError naming `option` unless `path` can be written: its folder exists and may be
+// written to, and it is not itself a folder. Called before any work, so that a bake or a run is
+// not wasted on an output that cannot be written. Empty paths are skipped.
+void RequireWritable(const std::string& option, const std::filesystem::path& path);
+
 // --lighting volume|lights:N, for the commands that render the objects (render::ParseLighting).
 void AddLightingOption(CLI::App* cmd, std::string* lighting);
 
-// While one lives, Ctrl-C sets flag() instead of ending the process: a run checks it after each
-// frame and ends with complete outputs. One at a time.
+// --frames N of estimate, replay, live and record: a whole number from 1 up, said one way where it
+// is not ("--frames: 0 is not a number of frames").
+CLI::Validator FrameCount();
+
+// While one lives, Ctrl-C or SIGTERM sets flag() instead of ending the process: a run checks it
+// after each frame and ends with complete outputs. A second one ends the process. One at a time.
 class StopOnInterrupt {
  public:
   StopOnInterrupt();

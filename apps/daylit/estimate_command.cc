@@ -39,6 +39,7 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   const std::string plot = o.plot.empty() ? std::filesystem::path(o.out).replace_extension(".png").string() : o.plot;
   RefuseSharedOutputs({{"--out", o.out}, {"--plot (or the --out's .png)", plot},
                        {"the bursts' table", evaluation::BurstsCsvPath(o.out)}, {"--figures", o.figures}});
+  RequireWritable("--out", o.out), RequireWritable("--plot", plot), RequireWritable("--figures", o.figures);
   const scene::Scene scene = scene::LoadScene(o.recording);
   // The frames first: a camera that is not there is an error now, not after the bake.
   std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
@@ -93,7 +94,7 @@ void AddEstimateCommand(CLI::App& app) {
   cmd->add_option("--samples", options->pipeline.estimator.sampler.samples, "Samples per frame (default 8000)")
       ->check(CLI::Range(100, 1000000));
   cmd->add_option("--frames", options->pipeline.max_frames, "Stop after this many frames (a live camera runs until Ctrl-C)")
-      ->check(CLI::PositiveNumber);
+      ->check(FrameCount());
   cmd->callback([options] { RunEstimateCommand(*options); });
 }
 

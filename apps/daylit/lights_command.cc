@@ -209,11 +209,18 @@ void RunLights(const LightsOptions& o) {
   if (o.threshold && !(*o.threshold > 0.0 && *o.threshold < 1.0)) {
     ThrowInputError("--threshold: {} is not a mean relative error in (0, 1)", *o.threshold);
   }
+  // The output folder first: a file in its place, or a folder that cannot be made or written, is
+  // said before the probe is read.
+  std::error_code ec;
+  fs::create_directories(o.out, ec);
+  if (ec || !fs::is_directory(o.out)) {
+    ThrowInputError("--out: {}: cannot make the folder ({})", o.out, ec ? ec.message() : "a file is in the way");
+  }
+  RequireWritable("--out", fs::path(o.out) / "errors.csv");
   lightfit::Probe probe = lightfit::LoadProbe(o.probe);
   for (const std::string& w : probe.warnings) Log().warn("{}", w);
   Log().info("{}: {}x{} lat-long{}", o.probe, probe.map.width, probe.map.height,
              probe.converted_from_angular ? " (converted from an angular map)" : "");
-  fs::create_directories(o.out);
   lightfit::LightFitOptions fit;
   fit.ambient = !o.no_ambient;
   lightfit::ProbeApproximations table(probe.map, fit);

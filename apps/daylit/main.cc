@@ -1,18 +1,30 @@
 // daylit: consistent lighting for outdoor augmented reality. See README.md.
 #include <cstdio>
 #include <exception>
+#include <filesystem>
+#include <string>
 
 #include <CLI/CLI.hpp>
+#include <opencv2/core/utils/logger.hpp>
 
 #include "apps/daylit/commands.h"
+#include "capture/video_decoder.h"
 #include "base/check.h"
 #include "base/error.h"
 #include "base/log.h"
+#include "base/version.h"
 #include "scene/scene.h"
 
 int main(int argc, char** argv) {
+  // libav's and OpenCV's own lines would come before daylit's one-line messages: libav's go to
+  // daylit's logger (debug), OpenCV's are silenced (daylit says what failed itself).
+  daylit::capture::RouteLibavLogging();
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   CLI::App app{"daylit: estimate sun and sky light from a camera and light virtual objects with it"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("daylit ") + daylit::kVersion);
+  // -q, -v and --allow-outside-paths work after the subcommand too.
+  app.fallthrough();
   int verbosity = 1;
   app.add_flag_callback("-q,--quiet", [&] { verbosity = 0; }, "Only warnings and errors on stderr");
   app.add_flag_callback("-v,--verbose", [&] { verbosity = 2; }, "Debug output on stderr");
@@ -32,11 +44,26 @@ int main(int argc, char** argv) {
   daylit::app::AddRelightCommand(app);
   daylit::app::AddLiveCommand(app);
   daylit::app::AddResultsCommand(app);
+  // The first word that is not an option must be a command: say so when it is not, rather than
+  // that one is required.
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.empty() || word[0] == '-') continue;
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands({})) known = known || sub->check_name(word);
+    if (!known) {
+      daylit::Log().error("'{}' is not a daylit command (see daylit --help)", word.substr(0, 80));
+      return daylit::kInputErrorExitCode;
+    }
+    break;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     daylit::Log().error("{} (see daylit --help)", e.what());
@@ -47,6 +74,11 @@ int main(int argc, char** argv) {
   } catch (const daylit::SystemError& e) {
     daylit::Log().error("{}", e.what());
     return 1;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the user gave that the system will not take (a symlink loop, a file where a folder
+    // must be, a read-only folder): bad input, with the path.
+    daylit::Log().error("{}: {}", e.path1().empty() ? std::string("a path") : e.path1().string(), e.code().message());
+    return daylit::kInputErrorExitCode;
   } catch (const daylit::InvariantError& e) {
     daylit::Log().critical("internal error (a bug in daylit, not your input): {}", e.what());
     return daylit::kInternalErrorExitCode;

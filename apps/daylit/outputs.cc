@@ -1,3 +1,6 @@
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cstddef>
 #include <filesystem>
 #include <string>
@@ -7,6 +10,8 @@
 
 #include "apps/daylit/commands.h"
 #include "base/error.h"
+
+#include <fmt/format.h>
 
 namespace daylit::app {
 
@@ -25,6 +30,31 @@ void RefuseSharedOutputs(const std::vector<std::pair<std::string, std::filesyste
                       outputs[j].first, outputs[i].second.string());
     }
   }
+}
+
+void RequireWritable(const std::string& option, const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  if (path.empty()) return;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) ThrowInputError("{}: {} is a folder, not a file to write", option, path.string());
+  const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  if (!fs::is_directory(folder, ec)) ThrowInputError("{}: {}: no such folder", option, folder.string());
+  // A file made and removed there says it (access() would say yes to root even on /proc).
+  const fs::path probe = folder / (".daylit-write-test-" + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+  if (fd < 0) ThrowInputError("{}: {}: may not be written to", option, folder.string());
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
+CLI::Validator FrameCount() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        const bool digits = !text.empty() && text.size() <= 9 && text.find_first_not_of("0123456789") == std::string::npos;
+        if (digits && std::stoi(text) >= 1) return {};
+        return fmt::format("{} is not a number of frames", text.substr(0, 40));
+      },
+      "N");
 }
 
 }  // namespace daylit::app

@@ -186,7 +186,7 @@ void AddRecordCommand(CLI::App& app) {
   cmd->add_option("--from", options->from, "A recording whose frames to write instead (to cut or convert it)");
   cmd->add_option("--scene", options->scene, "scene.json with the model, camera and location (default: --from's)");
   cmd->add_option("--out", options->out, "New recording folder")->required();
-  cmd->add_option("--frames", options->frames, "Stop after this many frames");
+  cmd->add_option("--frames", options->frames, "Stop after this many frames")->check(FrameCount());
   cmd->add_option("--seconds", options->seconds, "Stop after this many seconds of frames");
   cmd->add_flag("--images", options->images, "Lossless PNG frames instead of an H.264 video");
   cmd->add_option("--exposure-100us", options->exposure_100us,

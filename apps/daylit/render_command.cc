@@ -36,6 +36,7 @@ void RunRender(const RenderOptions& o) {
   const fs::path out(o.out);
   const std::string ext = out.extension().string();
   if (ext != ".png" && ext != ".exr") ThrowInputError("--out: {} must end in .png or .exr", o.out);
+  RequireWritable("--out", out);
   const scene::Scene scene = scene::LoadScene(o.recording);
   const size_t position = scene::FramePosition(scene, o.frame, "--frame");
   render::FrameRendererOptions options;

@@ -141,7 +141,7 @@ void AddPipelineOptions(CLI::App* cmd, const std::shared_ptr<ReplayOptions>& opt
   cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
   CLI::Option* out = cmd->add_option("--out", options->out,
                                      "Augmented video, .mp4 or .mkv (default " + default_out + "); its folder gets the report");
-  cmd->add_option("--frames", options->frames, "Stop after this many frames");
+  cmd->add_option("--frames", options->frames, "Stop after this many frames")->check(FrameCount());
   cmd->add_flag("--window", options->window,
                 "Show it in a window instead of writing the video (with fps, the sun and E_sun/E_sky swatches); "
                 "--out as well writes both; Esc, Q or closing the window ends it");

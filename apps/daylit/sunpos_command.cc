@@ -70,8 +70,8 @@ void PlotSunPath(const scene::Scene& scene, const sunmodel::Atmosphere& atmosphe
   report::Series path_azimuth{"sun", {}, {}, report::SeriesColor(0), false, false};
   const double span_s = scene.frame_times->SpanSeconds();
   for (double t = 0.0; t <= span_s + 1e-9; t += std::min(300.0, std::max(span_s, 1.0) / 2.0)) {
-    UtcTime at = frames.front().utc;
-    at.second += t;  // seconds past 59 are fine for the ephemeris and SecondsSince
+    // POSIX steps: a leap second inside the span moves the line's points by 1 s, not the dots.
+    const UtcTime at = UtcFromUnixSeconds(UnixSeconds(frames.front().utc) + t);
     const sunmodel::SunPosition sun = sun_at(at);
     path_elevation.x.push_back(at.SecondsSince(day_start) / 3600.0);
     path_elevation.y.push_back(sun.ApparentElevationDeg());

@@ -1,0 +1,17 @@
+// Whether a path the user gave can be read as a file, and if not, why, in the user's terms.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace daylit {
+
+// "" when `path` is a regular file (through symbolic links); else why not: "no such file", "is a
+// folder", "is not a regular file (a device, a FIFO or a socket)", or the system's own words (a
+// loop of symbolic links, a folder that may not be searched).
+std::string WhyNotAFile(const std::filesystem::path& path);
+
+// Throws InputError "<path>: <why>" unless `path` is a regular file.
+void RequireRegularFile(const std::filesystem::path& path);
+
+}  // namespace daylit
