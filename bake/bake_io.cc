@@ -363,12 +363,14 @@ SceneBake ReadBake(const fs::path& dir, const std::string& hash, const nlohmann:
     bake.gather.map_texels = static_cast<size_t>(bake.env.width) * static_cast<size_t>(bake.env.height);
   }
   const CsvTable albedo = ReadCsvFile(dir / "albedo.csv");
+  size_t column[5];
+  const char* names[5] = {"surface", "r", "g", "b", "pixels"};
+  for (size_t k = 0; k < 5; ++k) column[k] = static_cast<size_t>(albedo.RequireColumn(names[k]));
   for (size_t r = 0; r < albedo.rows.size(); ++r) {
     const auto& row = albedo.rows[r];
-    bake.albedo_table.push_back({row[0],
-                                 glm::vec3(ParseFiniteDouble(row[1], albedo.Where(r)), ParseFiniteDouble(row[2], albedo.Where(r)),
-                                           ParseFiniteDouble(row[3], albedo.Where(r))),
-                                 static_cast<size_t>(ParseFiniteDouble(row[4], albedo.Where(r)))});
+    const auto number = [&](size_t k) { return ParseFiniteDouble(row[column[k]], albedo.Where(r)); };
+    bake.albedo_table.push_back({row[column[0]], glm::vec3(number(1), number(2), number(3)),
+                                 static_cast<size_t>(ParseCount(row[column[4]], albedo.Where(r), INT32_MAX))});
   }
   const auto start = std::chrono::steady_clock::now();
   CheckLoadedBake(bake, j);

@@ -151,4 +151,13 @@ double ParseFiniteDouble(std::string_view text, std::string_view where) {
   return value;
 }
 
+int64_t ParseCount(std::string_view text, std::string_view where, int64_t most) {
+  double value = 0.0;
+  if (!TryParseFiniteDouble(text, &value) || value < 0.0 || value > static_cast<double>(most) ||
+      value != std::floor(value)) {
+    ThrowInputError("{}: '{}' is not a whole number from 0 to {}", where, Excerpt(Trim(text)), most);
+  }
+  return static_cast<int64_t>(value);
+}
+
 }  // namespace daylit

@@ -2,6 +2,7 @@
 // stable CSV interfaces: frames.csv, groundtruth.csv, `daylit sunpos --csv`.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -42,5 +43,9 @@ bool TryParseFiniteDouble(std::string_view text, double* value);
 
 // Parses a finite decimal number; throws InputError "<where>: '<text>' is not a finite number".
 double ParseFiniteDouble(std::string_view text, std::string_view where);
+
+// Parses a whole number in [0, `most`] (written as a decimal number with no fraction, "12" or
+// "12.0"); throws InputError "<where>: '<text>' is not a whole number from 0 to <most>".
+int64_t ParseCount(std::string_view text, std::string_view where, int64_t most);
 
 }  // namespace daylit

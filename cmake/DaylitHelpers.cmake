@@ -12,6 +12,12 @@ function(daylit_apply_flags target)
                                              -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
     target_link_options(${target} PRIVATE -fsanitize=address,undefined)
   endif()
+  if(DAYLIT_FUZZ)
+    # Coverage for libFuzzer in every daylit library; the targets link -fsanitize=fuzzer (fuzz/).
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link,address,undefined
+                                             -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+    target_link_options(${target} PRIVATE -fsanitize=address,undefined)
+  endif()
 endfunction()
 
 # daylit_add_library(NAME daylit_x SRCS a.h a.cc LINK_LIBS ...)
@@ -32,15 +38,17 @@ set(DAYLIT_TEST_ENVIRONMENT
     XDG_DATA_HOME=${DAYLIT_TEST_HOME}/share TMPDIR=${PROJECT_BINARY_DIR}/test-tmp)
 
 # daylit_add_test(NAME x_test SRCS x_test.cc LINK_LIBS ... [ENVIRONMENT VAR=value]
-#                 [FIXTURES fixture]): one GoogleTest binary whose tests are registered with
+#                 [FIXTURES fixture] [LABELS label]): one GoogleTest binary whose tests are registered with
 # ctest under "<folder>/<name>" so `ctest -R sunmodel/` runs one module. Its main()
 # (base/test_main.cc) keeps HOME, the XDG folders and TMPDIR inside the build tree. FIXTURES: the
-# CTest fixture its tests need (courtyard_bakes, the bundled recordings' bakes: tests/).
+# CTest fixture its tests need (courtyard_bakes, the bundled recordings' bakes: tests/). LABELS:
+# `accuracy` marks a binary whose tests measure whole recordings against the path tracer; the
+# sanitizer pass of scripts/test.sh leaves those out (the same code runs there in smaller tests).
 function(daylit_add_test)
   if(NOT DAYLIT_BUILD_TESTS)
     return()
   endif()
-  cmake_parse_arguments(ARG "" "NAME;ENVIRONMENT;FIXTURES" "SRCS;LINK_LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME;ENVIRONMENT;FIXTURES;LABELS" "SRCS;LINK_LIBS" ${ARGN})
   file(RELATIVE_PATH folder ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR})
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LINK_LIBS} daylit_test_main)
@@ -53,6 +61,9 @@ function(daylit_add_test)
   endif()
   if(ARG_FIXTURES)
     list(APPEND properties FIXTURES_REQUIRED "${ARG_FIXTURES}")
+  endif()
+  if(ARG_LABELS)
+    list(APPEND properties LABELS "${ARG_LABELS}")
   endif()
   # (gtest_discover_tests flattens PROPERTIES: one value per property, no lists.)
   if(properties)

@@ -35,7 +35,7 @@ TruthComparison CompareWithTruth(const std::vector<estimation::FrameEstimate>& f
       t.sun_rgb[k] = ParseFiniteDouble(table.rows[r][c[static_cast<size_t>(k)]], table.Where(r));
       t.sky_rgb[k] = ParseFiniteDouble(table.rows[r][c[static_cast<size_t>(k) + 3]], table.Where(r));
     }
-    truth_by_frame[static_cast<int>(ParseFiniteDouble(table.rows[r][c_frame], table.Where(r)))] = t;
+    truth_by_frame[static_cast<int>(ParseCount(table.rows[r][c_frame], table.Where(r) + ": frame", INT32_MAX))] = t;
   }
   TruthComparison cmp;
   std::array<std::vector<double>, 3> sun, sky, ratio;

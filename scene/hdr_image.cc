@@ -93,27 +93,74 @@ HdrImage ReadExrRgb(const std::filesystem::path& path) {
 }  // namespace
 
 void CheckExrClaimedSize(const std::filesystem::path& path, int64_t bytes_per_pixel) {
-  // The header as OpenEXR 2.0 lays it out: magic 76 2f 31 01, a version word, then attributes
-  // "name\0type\0" + int32 size + value, up to an empty name. The data window is a box2i (four
-  // int32: x min, y min, x max, y max). Read here, before OpenEXR builds anything from it.
+  // The header as OpenEXR 2.0 lays it out: magic 76 2f 31 01, a version word (bit 9: tiled,
+  // 11: deep, 12: multi-part), then attributes "name\0type\0" + int32 size + value, up to an
+  // empty name. The data window is a box2i (four int32: x min, y min, x max, y max). Read here,
+  // before OpenEXR builds anything from it.
   std::ifstream in(path, std::ios::binary);
   char head[8];
   if (!in.read(head, 8) || static_cast<unsigned char>(head[0]) != 0x76 || head[1] != 0x2f || head[2] != 0x31 || head[3] != 0x01) {
     return;  // not an OpenEXR file: OpenEXR says so
   }
+  const uint32_t flags = static_cast<uint8_t>(head[5]) | (static_cast<uint32_t>(static_cast<uint8_t>(head[6])) << 8);
+  const bool plain_scanlines = (flags & ((1u << 1) | (1u << 3) | (1u << 4))) == 0;  // bits 9, 11, 12
+  std::error_code ec;
+  const auto file_bytes = static_cast<int64_t>(std::filesystem::file_size(path, ec));
+  if (ec) return;
+  int32_t box[4] = {0, 0, -1, -1};
+  int compression = -1;
+  bool header_read = false;
   for (int attributes = 0; attributes < 1000; ++attributes) {
     std::string name, type;
-    if (!std::getline(in, name, '\0') || name.empty() || name.size() > 255) return;
+    if (!std::getline(in, name, '\0') || name.size() > 255) return;
+    if (name.empty()) {
+      header_read = true;
+      break;
+    }
     if (!std::getline(in, type, '\0') || type.size() > 255) return;
     int32_t size = 0;
-    if (!in.read(reinterpret_cast<char*>(&size), 4) || size < 0 || size > (1 << 24)) return;
+    if (!in.read(reinterpret_cast<char*>(&size), 4)) return;
+    if (size < 0 || static_cast<int64_t>(in.tellg()) + size > file_bytes) {
+      // OpenEXR would allocate it (up to 2 GB) before it finds the file short.
+      ThrowInputError("{}: its header's attribute '{}' claims {} bytes past the end of the file: truncated or damaged",
+                      path.string(), Excerpt(name), size);
+    }
     if (name == "dataWindow" && type == "box2i" && size == 16) {
-      int32_t box[4];
       if (!in.read(reinterpret_cast<char*>(box), 16)) return;
       CheckClaimedSize(path, int64_t{box[2]} - box[0] + 1, int64_t{box[3]} - box[1] + 1, bytes_per_pixel);
-      return;
+      continue;
+    }
+    if (name == "compression" && type == "compression" && size == 1) {
+      char c = 0;
+      if (!in.read(&c, 1)) return;
+      compression = static_cast<uint8_t>(c);
+      continue;
     }
     in.seekg(size, std::ios::cur);
+  }
+  // A plain scan-line file: its offset table, then chunks of "int32 y, int32 size, data". A
+  // chunk that claims more bytes than the file holds would have OpenEXR allocate them (up to
+  // 2 GB) before it finds the file short.
+  constexpr int kLinesPerChunk[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};  // NONE ... DWAB
+  if (!header_read || !plain_scanlines || compression < 0 || compression >= static_cast<int>(std::size(kLinesPerChunk)) ||
+      box[3] < box[1]) {
+    return;
+  }
+  const int64_t rows = int64_t{box[3]} - box[1] + 1;
+  const int64_t chunks = (rows + kLinesPerChunk[compression] - 1) / kLinesPerChunk[compression];
+  std::vector<uint64_t> offsets(static_cast<size_t>(chunks));
+  if (!in.read(reinterpret_cast<char*>(offsets.data()), static_cast<std::streamsize>(chunks * 8))) {
+    ThrowInputError("{}: truncated (its table of {} chunks ends early)", path.string(), chunks);
+  }
+  for (const uint64_t offset : offsets) {
+    // OpenEXR rebuilds a damaged table by itself; only chunks it points into the file are read.
+    if (offset == 0 || offset > static_cast<uint64_t>(file_bytes) - 8) continue;
+    int32_t chunk[2];
+    in.seekg(static_cast<std::streamoff>(offset));
+    if (!in.read(reinterpret_cast<char*>(chunk), 8)) return;
+    if (chunk[1] < 0 || static_cast<int64_t>(offset) + 8 + chunk[1] > file_bytes) {
+      ThrowInputError("{}: a chunk claims {} bytes past the end of the file: truncated or damaged", path.string(), chunk[1]);
+    }
   }
 }
 

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <fstream>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -64,6 +65,39 @@ TEST(HdrImageTest, MultiChannelExrRoundTripsFloatHalfAndUint) {
   EXPECT_EQ(ReadExrChannels(path, {}, {"surface"}).uints[0], ids);
   EXPECT_THROW(ReadExrChannels(path, {"albedo.R"}), InputError);
   std::filesystem::remove(path);
+}
+
+// A header attribute or a pixel chunk whose size runs past the end of the file: OpenEXR would
+// allocate the claimed bytes (up to 2 GB, found by fuzz_exr) before it notices the file is short.
+TEST(HdrImageTest, SizesThatLeaveTheFileAreRefusedBeforeOpenExrAllocatesThem) {
+  const int w = 16, h = 64;  // ZIP: 16 rows a chunk, 4 chunks
+  std::vector<float> r(w * h);
+  for (int i = 0; i < w * h; ++i) r[i] = std::sin(0.1f * static_cast<float>(i));
+  const auto path = Temp("whole.exr");
+  WriteExr(path, w, h, {{"R", ExrPixelType::kFloat, r.data(), nullptr}});
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_EQ(ReadExrChannels(path, {"R"}).planes[0], r);
+  const auto message = [](const std::filesystem::path& file) {
+    try {
+      ReadExrChannels(file, {"R"});
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const auto damaged = Temp("damaged.exr");
+  std::ofstream(damaged, std::ios::binary) << bytes.substr(0, bytes.size() - 10);  // the last chunk cut short
+  EXPECT_NE(message(damaged).find("a chunk claims"), std::string::npos) << message(damaged);
+  std::string huge_attribute = bytes;
+  const size_t at = huge_attribute.find(std::string("compression\0compression\0", 24));
+  ASSERT_NE(at, std::string::npos);
+  const int32_t size = 0x7fffffff;
+  huge_attribute.replace(at + 24, 4, reinterpret_cast<const char*>(&size), 4);
+  std::ofstream(damaged, std::ios::binary | std::ios::trunc) << huge_attribute;
+  EXPECT_NE(message(damaged).find("attribute 'compression' claims 2147483647 bytes past the end"), std::string::npos)
+      << message(damaged);
+  std::filesystem::remove(path), std::filesystem::remove(damaged);
 }
 
 TEST(HdrImageTest, EnvMapChecksNameTheCause) {

@@ -43,7 +43,8 @@ std::vector<JsonField> JsonField::Elements() const {
 
 void JsonField::WarnUnknownKeys(std::initializer_list<const char*> known) const {
   if (!value_->is_object()) return;  // reading its fields says what it should be
-  for (const auto& [key, unused] : value_->items()) {
+  for (const auto& item : value_->items()) {
+    const std::string& key = item.key();
     if (std::find_if(known.begin(), known.end(), [&](const char* k) { return key == k; }) ==
         known.end()) {
       Log().warn("{}: {}{}: unknown field, ignored", file_, path_.empty() ? "" : path_ + ".", key);
