@@ -17,6 +17,7 @@ struct DecodedFrame {
   FrameStatus status = FrameStatus::kEnd;
   Frame frame;
   std::exception_ptr error;  // a failure that is not the frame's own: ends the stream
+  int dropped = 0;           // the source's count of frames its driver dropped, up to this one
 };
 
 class ReadAheadSource final : public FrameSource {
@@ -48,6 +49,7 @@ class ReadAheadSource final : public FrameSource {
     if (next.status == FrameStatus::kEnd) ended_ = true;
     if (next.status == FrameStatus::kFrame) ++stats_.delivered;
     if (next.status == FrameStatus::kUndecodable) ++stats_.undecodable;
+    stats_.dropped = next.dropped;
     *frame = std::move(next.frame);
     return next.status;
   }
@@ -62,6 +64,7 @@ class ReadAheadSource final : public FrameSource {
       try {
         frame.status = source_->Next(&frame.frame);
         if (frame.status == FrameStatus::kWaiting) continue;
+        frame.dropped = source_->stats().dropped;  // read on the source's own thread
       } catch (...) {
         frame.error = std::current_exception();
       }

@@ -88,6 +88,7 @@ PipelineRun LightingPipeline::Run(std::unique_ptr<capture::FrameSource> source) 
     }
   }
   run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  run.dropped = frames->stats().dropped;
   run.median_estimate_ms = MedianInPlace(estimate_ms, static_cast<double>(NAN));
   run.median_stage_ms = MedianInPlace(stage_ms, 0.0);
   return run;

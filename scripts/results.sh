@@ -50,6 +50,19 @@ for recording in recordings/*/; do
   "$daylit" -q replay "$recording" --cache "build/results-cache/$name" --out "$out/$name/replay/replay.mp4" >/dev/null
 done
 
+# daylit live on the userspace V4L2 test device (tests/fakecam, docs/capture.md) serving
+# courtyard-a's frames as YUYV at 30 fps: does the pipeline keep up with the camera?
+echo "results: daylit live on the test device at 30 fps" >&2
+live="$out/live"
+mkdir -p "$live"
+cp recordings/courtyard-a/model.obj recordings/courtyard-a/envmap.exr "$live/"
+sed -z 's|"frames": {[^}]*}|"frames": {"device": "/dev/video-daylit-results", "fps": 30}|; s|,[[:space:]]*"groundtruth": {[^}]*}||' \
+  recordings/courtyard-a/scene.json >"$live/scene.json"
+LD_PRELOAD="$PWD/build/tests/libdaylit_fakecam.so" DAYLIT_FAKECAM_DEVICE=/dev/video-daylit-results \
+  DAYLIT_FAKECAM_VIDEO=recordings/courtyard-a/video.mp4 DAYLIT_FAKECAM_FRAMES=60 DAYLIT_FAKECAM_FORMATS=YUYV \
+  "$daylit" -q live --scene "$live/scene.json" --cache "build/results-cache/live" --frames 300 \
+  --out "$live/live.mp4" >/dev/null
+
 # Seed 002's benchmark on the five lat-long probes (docs/relight.md).
 for probe in galileo_latlong_1024x512 stpeters_latlong_1024x512 uffizi-large_1024x512 rooitou_park_1k potsdamer_platz_1k; do
   echo "results: daylit lights on $probe" >&2

@@ -20,10 +20,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bake/synthetic_recording.h"
+#include "tests/cli_run.h"
 #include "capture/response.h"
 #include "capture/video_decoder.h"
 #include "base/atomic_file.h"
 #include "base/csv.h"
+#include "base/utc_time.h"
+#include "report/plot.h"
 #include "sh/exact_irradiance.h"
 #include "lightfit/lights.h"
 #include "scene/hdr_image.h"
@@ -34,33 +37,59 @@ namespace daylit {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CliRun {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-CliRun Daylit(const std::string& args, const std::string& environment = "") {
-  static int counter = 0;
-  const fs::path err_file = fs::temp_directory_path() /
-                            ("daylit_cli_err_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-  const std::string command = environment + std::string(DAYLIT_BINARY_DIR "/bin/daylit ") + args + " 2>" + err_file.string();
-  CliRun run;
-  FILE* pipe = ::popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buffer;
-  size_t n = 0;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), n);
-  const int status = ::pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.err = ReadTextFile(err_file);
-  fs::remove(err_file);
-  return run;
-}
+using cli_testing::CliRun;
+using cli_testing::Daylit;
 
 const std::string kRecording = DAYLIT_SOURCE_DIR "/recordings/courtyard-a";
 const std::string kProbe = DAYLIT_SOURCE_DIR "/probes/stpeters_latlong_1024x512.hdr";
+
+// Where a plot drew one colour: the columns holding a pixel of exactly `rgb` inside `region`
+// (anti-aliased lines keep their colour at their centre), and each column's highest such row;
+// `skip` (the legend, top right) is left out. Plot facts are checked on these: a curve drawn
+// where its data says, not only a PNG that exists.
+struct Trace {
+  std::map<int, int> top_row;  // column -> smallest row
+  int Left() const { return top_row.empty() ? -1 : top_row.begin()->first; }
+  int Right() const { return top_row.empty() ? -1 : top_row.rbegin()->first; }
+  // The mean column of the curve's highest pixels.
+  double PeakColumn() const {
+    int best = 1 << 30;
+    for (const auto& [column, row] : top_row) best = std::min(best, row);
+    double sum = 0.0;
+    int n = 0;
+    for (const auto& [column, row] : top_row) {
+      if (row == best) sum += column, ++n;
+    }
+    return n > 0 ? sum / n : -1.0;
+  }
+  // Runs of adjacent columns: one per vertical line drawn.
+  std::vector<double> Runs() const {
+    std::vector<double> centres;
+    int start = -10, last = -10;
+    for (const auto& [column, row] : top_row) {
+      if (column > last + 1) {
+        if (last >= 0) centres.push_back(0.5 * (start + last));
+        start = column;
+      }
+      last = column;
+    }
+    if (last >= 0) centres.push_back(0.5 * (start + last));
+    return centres;
+  }
+};
+
+Trace TraceOf(const cv::Mat& image, const cv::Rect& region, std::array<int, 3> rgb, const cv::Rect& skip = {}) {
+  Trace t;
+  const cv::Vec3b bgr(static_cast<uchar>(rgb[2]), static_cast<uchar>(rgb[1]), static_cast<uchar>(rgb[0]));
+  for (int y = region.y; y < region.y + region.height; ++y) {
+    for (int x = region.x; x < region.x + region.width; ++x) {
+      if (image.at<cv::Vec3b>(y, x) != bgr || skip.contains({x, y})) continue;
+      const auto it = t.top_row.find(x);
+      if (it == t.top_row.end() || y < it->second) t.top_row[x] = y;
+    }
+  }
+  return t;
+}
 
 TEST(CliTest, HelpForEverySubcommand) {
   for (const char* sub : {"", "sunpos ", "info ", "lights ", "record ", "render ", "replay ", "live ", "calibrate-response ", "calibrate-camera "}) {
@@ -105,7 +134,37 @@ TEST(CliTest, SunposFramesWritesOneRowPerFrame) {
   EXPECT_EQ(table.header.back(), "sun_z");
   const cv::Mat image = cv::imread(plot.string());
   fs::remove(plot);
-  EXPECT_EQ(image.size(), cv::Size(1200, 640));  // two 1200 x 320 panels
+  ASSERT_EQ(image.size(), cv::Size(1200, 640));  // two 1200 x 320 panels
+  // What the elevation panel shows: a dot per burst (frames 0.1 s apart overlap), the highest
+  // one the burst the CSV gives the highest sun, each on the sun's path line.
+  std::vector<double> burst_elevation;
+  const size_t c_time = static_cast<size_t>(table.RequireColumn("time_utc"));
+  const size_t c_elevation = static_cast<size_t>(table.RequireColumn("elevation_deg"));
+  for (size_t r = 0; r < table.rows.size(); ++r) {
+    const double elevation = ParseFiniteDouble(table.rows[r][c_elevation], "elevation");
+    const bool starts = r == 0 || ParseUtcTime(table.rows[r][c_time], "t").SecondsSince(ParseUtcTime(table.rows[r - 1][c_time], "t")) > 2.0;
+    if (starts) burst_elevation.push_back(elevation);
+    burst_elevation.back() = std::max(burst_elevation.back(), elevation);
+  }
+  // Inside the top panel's plot area (report/plot.cc: 80 px left, 20 right, 50 top, 48 bottom),
+  // off its frame, whose ink is the dots' colour.
+  const cv::Rect top_panel(82, 52, 1096, 218), legend(1040, 40, 160, 60);
+  const Trace dots = TraceOf(image, top_panel, {40, 40, 40}, legend);
+  const Trace path = TraceOf(image, top_panel, report::SeriesColor(1), legend);
+  const std::vector<double> clusters = dots.Runs();
+  ASSERT_EQ(clusters.size(), burst_elevation.size());
+  size_t highest = 0;
+  int highest_row = 1 << 30;
+  for (size_t b = 0; b < clusters.size(); ++b) {
+    const int column = static_cast<int>(std::lround(clusters[b]));
+    const int dot_centre = dots.top_row.at(column) + 3;  // radius 3
+    if (dot_centre < highest_row) highest_row = dot_centre, highest = b;
+    // The path's line just beside the dot (the dot covers it at its centre).
+    const int beside = column + (b + 1 < clusters.size() ? 6 : -6);
+    ASSERT_TRUE(path.top_row.count(beside)) << "no path line beside burst " << b;
+    EXPECT_NEAR(path.top_row.at(beside) + 1, dot_centre, 6) << "burst " << b;
+  }
+  EXPECT_EQ(highest, static_cast<size_t>(std::max_element(burst_elevation.begin(), burst_elevation.end()) - burst_elevation.begin()));
 }
 
 TEST(CliTest, SunposCsvBatchMatchesThePublishedSpaExample) {
@@ -208,6 +267,35 @@ TEST(CliTest, ResultsFillsThePageOrNamesTheMissingFigure) {
   fs::remove_all(dir);
 }
 
+// lighting.png marks each burst's start (frames more than 2 s apart) with a grey line where its
+// first frame is on the frame axis.
+TEST(CliTest, EstimatePlotMarksWhereEachBurstStarts) {
+  bake::testing::SyntheticRecording rec("cli_estimate_bursts");
+  const std::string scene = rec.Write().string();
+  for (const char* frame : {"000001.png", "000002.png", "000003.png", "000004.png"}) {
+    fs::copy_file(rec.dir / "frames" / "000000.png", rec.dir / "frames" / frame);
+  }
+  // Bursts at frames 0-1 and 2-4: frame 2 is the middle of the axis (frames 0 to 4).
+  WriteFileAtomically(rec.dir / "frames.csv",
+                      "frame,time_utc\n0,2026-06-21T00:00:00Z\n1,2026-06-21T00:00:00.1Z\n2,2026-06-21T00:00:30Z\n"
+                      "3,2026-06-21T00:00:30.1Z\n4,2026-06-21T00:00:30.2Z\n");
+  const fs::path out = rec.dir / "est.csv";
+  const CliRun run = Daylit("estimate " + scene + " --cache " + (rec.dir / "cache").string() + " --out " + out.string());
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(ReadCsvFile(rec.dir / "est_bursts.csv").rows.size(), 2u);
+  const cv::Mat plot = cv::imread((rec.dir / "est.png").string());
+  ASSERT_EQ(plot.size(), cv::Size(1400, 720));  // E_sun over E_sky, 1400 x 360 each
+  // The E_sky panel's plot area (report/plot.cc's margins), its legend at the top right left out.
+  const cv::Rect inside(82, 360 + 52, 1296, 258), legend(1150, 360 + 40, 250, 100);
+  const Trace starts = TraceOf(plot, inside, {150, 150, 150}, legend);
+  // The flat E_sky estimate over frames 0 to 4 (a grey sky: blue, drawn last, covers R and G).
+  const Trace sky = TraceOf(plot, inside, {31, 119, 180}, legend);
+  const std::vector<double> lines = starts.Runs();
+  ASSERT_EQ(lines.size(), 1u) << "one line: the second burst's start";
+  ASSERT_GT(sky.Right() - sky.Left(), 1000);
+  EXPECT_NEAR(lines[0], 0.5 * (80 + 1380), 2.0) << "frame 2 of 0 to 4";
+}
+
 TEST(CliTest, EstimateSkipsAFrameThatCannotBeDecodedAndGoesOn) {
   bake::testing::SyntheticRecording rec("cli_estimate_corrupt");
   const std::string scene = rec.Write().string();
@@ -295,8 +383,24 @@ TEST(CliTest, LightsWritesTheLightsTheirErrorsAndTheAutomaticN) {
   EXPECT_GE(mean_of["io_" + std::to_string(io_n - 1)], 0.05);
   EXPECT_LT(mean_of["mediancut_" + std::to_string(mc_n)], 0.05);
   EXPECT_GE(mean_of["mediancut_" + std::to_string(mc_n - 1)], 0.05);
-  EXPECT_TRUE(fs::is_regular_file(out / "errors.png"));
   EXPECT_TRUE(fs::is_regular_file(out / "sh9.json"));
+  // The mean-error panel (1000 x 380, log-log) draws irradiance optimization below median cut
+  // wherever both are drawn, as the CSV has it at every shared N.
+  for (const int n : {1, 2, 4, 8}) {
+    EXPECT_LT(mean_of["io_" + std::to_string(n)], mean_of["mediancut_" + std::to_string(n)]) << n;
+  }
+  const cv::Mat plot = cv::imread((out / "errors.png").string());
+  ASSERT_EQ(plot.size(), cv::Size(1000, 760));
+  const cv::Rect inside(82, 52, 896, 278), legend(760, 40, 240, 80);
+  const Trace mc = TraceOf(plot, inside, report::SeriesColor(0), legend), io = TraceOf(plot, inside, report::SeriesColor(1), legend);
+  size_t shared = 0, below = 0;
+  for (const auto& [column, row] : io.top_row) {
+    if (!mc.top_row.count(column)) continue;
+    ++shared;
+    below += row > mc.top_row.at(column) ? 1 : 0;
+  }
+  EXPECT_GT(shared, 400u) << "both curves across most of the panel";
+  EXPECT_EQ(below, shared);
   fs::remove_all(out);
 }
 

@@ -59,6 +59,10 @@ void WriteReplayReport(const scene::Scene& scene, const pipeline::PipelineRun& r
   report.Say(fmt::format("  per frame (median): estimate {:.1f} ms, relight + render {:.1f} ms (encoding on its own thread)",
                          run.median_estimate_ms, run.median_stage_ms));
   if (run.undecodable > 0) report.Say(fmt::format("  {} frames could not be decoded (shown as the frame before)", run.undecodable));
+  if (live) {
+    report.Say(fmt::format("  {} frames dropped by the camera's driver (gaps in its sequence numbers)", run.dropped));
+    report.Figure("dropped", run.dropped);
+  }
   if (const lightfit::EnvLights* lights = renderer.env_lights()) {
     report.Say(fmt::format("  the objects lit by the sun and {} lights, their directions fitted {} times (sun moves and "
                            "large changes of the light; {} stopped at the iteration limit)",
