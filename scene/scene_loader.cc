@@ -8,6 +8,7 @@
 #include "capture/frame_source.h"
 #include "capture/v4l2_source.h"
 #include "scene/json_fields.h"
+#include "scene/object_mesh.h"
 #include "scene/scene.h"
 
 namespace daylit::scene {
@@ -303,6 +304,8 @@ void LoadObjects(const JsonField& root, Scene* scene) {
         a->Fail("each channel must be in [0, 1]");
       }
     }
+    // Read the mesh now: a damaged file is said here, by every command, not after a bake.
+    if (object.kind == MeshKind::kFile) ObjectMesh(object);
     scene->objects.push_back(object);
   }
 }

@@ -844,6 +844,11 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
   scene::testing::SceneSandbox empty("cli_no_surfaces");
   empty.json()["diffuse_surfaces"] = nlohmann::json::array();
   const fs::path no_surfaces = empty.Write();
+  // A garbage .glb object: said before any bake (render baked 15 s before it read the object).
+  scene::testing::SceneSandbox glb("cli_garbage_glb");
+  glb.WriteText("statue.glb", "glTF but not a binary glTF");
+  glb.json()["objects"] = {{{"mesh", "statue.glb"}, {"position", {0, 0, 0.5}}}};
+  const fs::path garbage_glb = glb.Write();
   scene::testing::SceneSandbox live("cli_live");
   live.json()["frames"] = {{"device", "/dev/video-daylit-absent"}, {"fps", 30}};
   const fs::path live_scene = live.Write();
@@ -929,6 +934,8 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"estimate " + kRecording + " --frames 0", "--frames: 0 is not a number of frames"},
       {"info " + long_token.string(), "vertex coordinate x is not a finite number"},
       {"info " + no_surfaces.string(), "diffuse_surfaces: empty"},
+      {"render " + garbage_glb.string() + " --frame 0 --out " + dir + "/f.png", "statue.glb: not a glTF 2.0 file"},
+      {"estimate " + garbage_glb.string(), "statue.glb: not a glTF 2.0 file"},
       // The command line itself.
       {"frobnicate", "'frobnicate' is not a daylit command"},
       {"lights " + (sandbox.dir() / "huge.exr").string() + " --out " + dir + "/l",

@@ -10,7 +10,6 @@
 #include "evaluation/lighting_truth.h"
 #include "capture/video_probe.h"
 #include "scene/envmap_probe.h"
-#include "scene/object_mesh.h"
 #include "scene/scene.h"
 #include "sunmodel/solar_position.h"
 
@@ -149,8 +148,6 @@ void PrintEnvMap(const scene::Scene& scene, std::vector<std::string>* missing) {
 void PrintObjectsAndVolume(const scene::Scene& scene, std::vector<std::string>* missing) {
   fmt::print("objects      {}\n", scene.objects.size());
   for (const scene::VirtualObject& o : scene.objects) {
-    // Load each mesh now (a damaged .glb is said here, not after a bake).
-    if (o.kind == scene::MeshKind::kFile) scene::ObjectMesh(o);
     const std::string what = o.kind == scene::MeshKind::kSphere ? fmt::format("builtin:sphere r {:.3g} m", o.radius)
                              : o.kind == scene::MeshKind::kBox
                                  ? fmt::format("builtin:box {:.3g} x {:.3g} x {:.3g} m", o.size.x, o.size.y, o.size.z)

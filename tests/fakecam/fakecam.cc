@@ -524,30 +524,30 @@ FakeCamera& Camera() {
 
 extern "C" {
 
-int open(const char* path, int flags, ...) {
-  mode_t mode = 0;
-  if (flags & (O_CREAT | O_TMPFILE)) {
-    va_list args;
-    va_start(args, flags);
-    mode = static_cast<mode_t>(va_arg(args, int));
-    va_end(args);
-  }
+namespace {
+// open and open64: the device's path to the camera, any other to the real call of that name.
+int OpenPath(const char* real_name, const char* path, int flags, va_list args) {
+  const mode_t mode = (flags & (O_CREAT | O_TMPFILE)) ? static_cast<mode_t>(va_arg(args, int)) : 0;
   if (Camera().Handles(path)) return Camera().Open();
-  static const auto real = Real<int (*)(const char*, int, ...)>("open");
+  const auto real = Real<int (*)(const char*, int, ...)>(real_name);
   return real(path, flags, mode);
+}
+}  // namespace
+
+int open(const char* path, int flags, ...) {
+  va_list args;
+  va_start(args, flags);
+  const int fd = OpenPath("open", path, flags, args);
+  va_end(args);
+  return fd;
 }
 
 int open64(const char* path, int flags, ...) {
-  mode_t mode = 0;
-  if (flags & (O_CREAT | O_TMPFILE)) {
-    va_list args;
-    va_start(args, flags);
-    mode = static_cast<mode_t>(va_arg(args, int));
-    va_end(args);
-  }
-  if (Camera().Handles(path)) return Camera().Open();
-  static const auto real = Real<int (*)(const char*, int, ...)>("open64");
-  return real(path, flags, mode);
+  va_list args;
+  va_start(args, flags);
+  const int fd = OpenPath("open64", path, flags, args);
+  va_end(args);
+  return fd;
 }
 
 int close(int fd) {
