@@ -1,4 +1,5 @@
 #include "scene/hdr_image.h"
+#include "scene/radiance_hdr.h"
 
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
@@ -12,7 +13,6 @@
 #include <cstdio>
 #include <fstream>
 
-#include <opencv2/imgcodecs.hpp>
 
 #include "base/atomic_file.h"
 #include "base/error.h"
@@ -217,18 +217,10 @@ HdrImage ReadHdrImage(const std::filesystem::path& path) {
   int width = 0, height = 0;
   ReadRadianceSize(path, &width, &height);
   CheckClaimedSize(path, width, height, 4);  // RGBE: 4 bytes a pixel
-  const cv::Mat bgr = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
-  if (bgr.empty() || bgr.depth() != CV_32F || bgr.channels() != 3) {
-    ThrowInputError("{}: not a readable Radiance HDR (or OpenEXR) image", path.string());
-  }
-  HdrImage image{bgr.cols, bgr.rows, {}};
-  image.rgb.resize(static_cast<size_t>(image.width) * image.height * 3);
-  for (int y = 0; y < bgr.rows; ++y) {
-    const cv::Vec3f* row = bgr.ptr<cv::Vec3f>(y);
-    for (int x = 0; x < bgr.cols; ++x) {
-      float* p = image.Pixel(x, y);
-      p[0] = row[x][2], p[1] = row[x][1], p[2] = row[x][0];
-    }
+  HdrImage image{0, 0, {}};
+  std::string why;
+  if (!DecodeRadianceHdr(path, &image.width, &image.height, &image.rgb, &why)) {
+    ThrowInputError("{}: not a readable Radiance HDR (or OpenEXR) image ({})", path.string(), why);
   }
   return image;
 }
