@@ -38,6 +38,7 @@ struct SourceStats {
   int delivered = 0;    // frames returned
   int undecodable = 0;  // frames that could not be decoded or read
   int dropped = 0;      // live: frames the driver's sequence numbers show were never delivered
+  int skipped = 0;      // live: frames delivered while a newer one was waiting, given back unread
   // Paced replay: the time its schedule gave the frames so far, seconds (the recording's time
   // over the speed, gaps between bursts left out). Time spent is at least this.
   double scheduled_s = 0.0;

@@ -17,7 +17,8 @@ struct DecodedFrame {
   FrameStatus status = FrameStatus::kEnd;
   Frame frame;
   std::exception_ptr error;  // a failure that is not the frame's own: ends the stream
-  int dropped = 0;           // the source's count of frames its driver dropped, up to this one
+  int dropped = 0;           // the source's counts of frames its driver dropped and it skipped,
+  int skipped = 0;           // up to this one
 };
 
 class ReadAheadSource final : public FrameSource {
@@ -49,7 +50,7 @@ class ReadAheadSource final : public FrameSource {
     if (next.status == FrameStatus::kEnd) ended_ = true;
     if (next.status == FrameStatus::kFrame) ++stats_.delivered;
     if (next.status == FrameStatus::kUndecodable) ++stats_.undecodable;
-    stats_.dropped = next.dropped;
+    stats_.dropped = next.dropped, stats_.skipped = next.skipped;
     *frame = std::move(next.frame);
     return next.status;
   }
@@ -65,6 +66,7 @@ class ReadAheadSource final : public FrameSource {
         frame.status = source_->Next(&frame.frame);
         if (frame.status == FrameStatus::kWaiting) continue;
         frame.dropped = source_->stats().dropped;  // read on the source's own thread
+        frame.skipped = source_->stats().skipped;
       } catch (...) {
         frame.error = std::current_exception();
       }

@@ -155,6 +155,13 @@ class V4l2Source final : public FrameSource {
         return FrameStatus::kWaiting;
       }
     }
+    if (!streaming_) {
+      // Streaming starts with the first frame asked for, not at open: the bake between the two
+      // would leave the buffers holding frames from before it and the sequence numbers a gap.
+      v4l2_buf_type type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+      if (Ioctl(fd_, VIDIOC_STREAMON, &type) < 0) ThrowInputError("{}: cannot start streaming", device_);
+      streaming_ = true;
+    }
     pollfd p{fd_, POLLIN, 0};
     const int ready = ::poll(&p, 1, 1000);
     if (ready == 0) return FrameStatus::kWaiting;
@@ -168,15 +175,25 @@ class V4l2Source final : public FrameSource {
       next_retry_ = std::chrono::steady_clock::now() + std::chrono::seconds(1);
       return FrameStatus::kWaiting;
     }
+    // Behind the camera: the driver holds newer frames than this one. Take the newest and give
+    // the older ones back, so that a pipeline slower than the camera works on what the camera
+    // sees now, frames skipped, instead of falling further behind.
+    while (options_.newest_only) {
+      v4l2_buffer newer{};
+      newer.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
+      newer.memory = V4L2_MEMORY_MMAP;
+      if (Ioctl(fd_, VIDIOC_DQBUF, &newer) < 0) break;  // EAGAIN: none newer
+      CountSequence(buffer.sequence);
+      Ioctl(fd_, VIDIOC_QBUF, &buffer);
+      ++stats_.skipped;
+      buffer = newer;
+    }
+    CountSequence(buffer.sequence);
     timespec monotonic{};
     ::clock_gettime(CLOCK_MONOTONIC, &monotonic);
     timespec real{};
     ::clock_gettime(CLOCK_REALTIME, &real);
     const UtcTime utc_now = UtcFromUnixSeconds(static_cast<double>(real.tv_sec) + 1e-9 * static_cast<double>(real.tv_nsec));
-    if (last_sequence_ >= 0 && buffer.sequence > static_cast<uint32_t>(last_sequence_) + 1) {
-      stats_.dropped += static_cast<int>(buffer.sequence - static_cast<uint32_t>(last_sequence_) - 1);
-    }
-    last_sequence_ = static_cast<int64_t>(buffer.sequence);
     frame->index = next_index_++;
     frame->utc = KernelTimestampToUtc(buffer.timestamp, monotonic, utc_now);
     frame->exposure = options_.exposure;
@@ -189,6 +206,14 @@ class V4l2Source final : public FrameSource {
     }
     ++stats_.delivered;
     return FrameStatus::kFrame;
+  }
+
+  // Frames the driver never delivered: gaps in the sequence numbers of those it did.
+  void CountSequence(uint32_t sequence) {
+    if (last_sequence_ >= 0 && sequence > static_cast<uint32_t>(last_sequence_) + 1) {
+      stats_.dropped += static_cast<int>(sequence - static_cast<uint32_t>(last_sequence_) - 1);
+    }
+    last_sequence_ = static_cast<int64_t>(sequence);
   }
 
   void Seek(int) override { ThrowInputError("{}: a live camera cannot seek", device_); }
@@ -321,8 +346,7 @@ class V4l2Source final : public FrameSource {
       mapped_.emplace_back(data, buffer.length);
       if (Ioctl(fd_, VIDIOC_QBUF, &buffer) < 0) ThrowInputError("{}: cannot queue buffer {}", device_, i);
     }
-    v4l2_buf_type type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-    if (Ioctl(fd_, VIDIOC_STREAMON, &type) < 0) ThrowInputError("{}: cannot start streaming", device_);
+    streaming_ = false;  // STREAMON with the first Next()
     last_sequence_ = -1;
   }
 
@@ -357,6 +381,7 @@ class V4l2Source final : public FrameSource {
   V4l2Format format_;
   std::vector<std::pair<void*, size_t>> mapped_;
   int64_t last_sequence_ = -1;
+  bool streaming_ = false;
   int next_index_ = 0;
   std::chrono::steady_clock::time_point next_retry_;
 };

@@ -72,9 +72,13 @@ struct V4l2Options {
   CameraSettings settings;
   double exposure = 1.0;  // scene.json's camera.exposure: linear pixel = k · radiance
   int buffers = 4;        // mmap buffers queued in the driver
+  // Each Next() takes the newest frame the driver holds, giving older ones back unread (counted
+  // as skipped): for a pipeline that must not fall behind the camera. Off: every frame, in
+  // order (daylit record).
+  bool newest_only = false;
 };
 
-// Opens `device` and starts streaming. Throws InputError "<device>: ..." when it does not exist,
+// Opens `device` and configures it; streaming starts with the first Next(). Throws InputError "<device>: ..." when it does not exist,
 // is not a V4L2 capture device, or offers neither MJPEG nor YUYV.
 std::unique_ptr<FrameSource> OpenV4l2Source(const std::string& device, const V4l2Options& options);
 

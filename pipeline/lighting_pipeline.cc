@@ -1,6 +1,7 @@
 #include "pipeline/lighting_pipeline.h"
 
 #include <algorithm>
+#include <ctime>
 #include <chrono>
 #include <cmath>
 
@@ -11,6 +12,7 @@
 #include "base/log.h"
 #include "base/progress.h"
 #include "base/statistics.h"
+#include "base/utc_time.h"
 #include "capture/read_ahead.h"
 
 namespace daylit::pipeline {
@@ -41,7 +43,9 @@ bool LightingPipeline::StopRequested() const {
 
 PipelineRun LightingPipeline::Run(std::unique_ptr<capture::FrameSource> source) {
   DAYLIT_CHECK(video_ == nullptr || stage_ != nullptr, "a video needs a stage that makes its images");
-  std::unique_ptr<capture::FrameSource> frames = capture::ReadAhead(std::move(source));
+  // A camera's frames are decoded one ahead at most: a deeper queue is only lag.
+  const bool live = source->live();
+  std::unique_ptr<capture::FrameSource> frames = capture::ReadAhead(std::move(source), live ? 1 : 4);
   scene::SunTracker sun_tracker(scene_, options_.sun);
   estimation::FrameEstimator estimator(scene_, bake_, caster_, options_.estimator);
   PipelineRun run;
@@ -68,6 +72,12 @@ PipelineRun LightingPipeline::Run(std::unique_ptr<capture::FrameSource> source) 
     const Clock::time_point began = Clock::now();
     const estimation::FrameLight light = readable ? estimator.Estimate(frame, sun) : estimator.Hold(frame, sun);
     if (readable) (light.sun_moved ? run.sun_moves_ms : estimate_ms).push_back(MillisecondsSince(began));
+    if (readable && live) {
+      timespec now{};
+      ::clock_gettime(CLOCK_REALTIME, &now);
+      const double now_s = static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+      run.latency_ms.push_back(1e3 * (now_s - UnixSeconds(frame.utc)));
+    }
     if (!readable) {
       ++run.undecodable;
       frame.rgb.release();
@@ -88,7 +98,7 @@ PipelineRun LightingPipeline::Run(std::unique_ptr<capture::FrameSource> source) 
     }
   }
   run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  run.dropped = frames->stats().dropped;
+  run.dropped = frames->stats().dropped, run.skipped = frames->stats().skipped;
   run.median_estimate_ms = MedianInPlace(estimate_ms, static_cast<double>(NAN));
   run.median_stage_ms = MedianInPlace(stage_ms, 0.0);
   return run;

@@ -76,6 +76,10 @@ struct PipelineRun {
   std::vector<estimation::FrameEstimate> frames;  // every frame read, in order
   int undecodable = 0;
   int dropped = 0;  // a live camera: frames its driver's sequence numbers show were never delivered
+  int skipped = 0;  // a live camera: frames given back unread because a newer one was waiting
+  // A live camera: each frame's age when its estimate was done (wall clock minus its capture
+  // instant), ms: how far the pipeline runs behind the camera.
+  std::vector<double> latency_ms;
   double seconds = 0.0;              // wall time of the loop, decoding (on its own thread) included
   double median_estimate_ms = 0.0;   // the estimate after decoding, median over frames without a sun move
   std::vector<double> sun_moves_ms;  // the estimate of frames with one: shadow rays, strata, transfer terms

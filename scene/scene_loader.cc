@@ -396,6 +396,7 @@ std::unique_ptr<capture::FrameSource> OpenFrameSource(const Scene& scene) {
   options.fps = scene.frames.fps;
   options.settings = scene.frames.controls;
   options.exposure = scene.exposure;
+  options.newest_only = true;  // estimate and live run on what the camera sees now
   return capture::OpenV4l2Source(scene.frames.device, options);
 }
 

@@ -2,6 +2,7 @@
 // capture, sun, estimation, relighting, irradiance volume, compositing) into an augmented H.264
 // video, with the estimates, their plot and a report beside it (docs/render.md).
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -11,6 +12,7 @@
 
 #include "apps/daylit/commands.h"
 #include "bake/bake.h"
+#include "base/statistics.h"
 #include "base/error.h"
 #include "base/log.h"
 #include "capture/frame_source.h"
@@ -60,8 +62,21 @@ void WriteReplayReport(const scene::Scene& scene, const pipeline::PipelineRun& r
                          run.median_estimate_ms, run.median_stage_ms));
   if (run.undecodable > 0) report.Say(fmt::format("  {} frames could not be decoded (shown as the frame before)", run.undecodable));
   if (live) {
-    report.Say(fmt::format("  {} frames dropped by the camera's driver (gaps in its sequence numbers)", run.dropped));
+    std::vector<double> latency = run.latency_ms;
+    std::sort(latency.begin(), latency.end());
+    const auto at = [&](double q) {
+      return latency.empty() ? NAN : latency[std::min(latency.size() - 1, static_cast<size_t>(q * static_cast<double>(latency.size())))];
+    };
+    const double median = at(0.5), p95 = at(0.95), worst = latency.empty() ? NAN : latency.back();
+    report.Say(fmt::format("  {} frames dropped by the camera's driver (gaps in its sequence numbers), {} skipped "
+                           "(a newer one was waiting); a frame's age when estimated: median {:.0f} ms, 95th percentile "
+                           "{:.0f} ms, worst {:.0f} ms (the first frame waits for the set-up)",
+                           run.dropped, run.skipped, median, p95, worst));
+    report.Figure("latency_p95_ms", p95);
     report.Figure("dropped", run.dropped);
+    report.Figure("skipped", run.skipped);
+    report.Figure("latency_median_ms", median);
+    report.Figure("latency_worst_ms", worst);
   }
   if (const lightfit::EnvLights* lights = renderer.env_lights()) {
     report.Say(fmt::format("  the objects lit by the sun and {} lights, their directions fitted {} times (sun moves and "
