@@ -100,6 +100,40 @@ TEST(HdrImageTest, SizesThatLeaveTheFileAreRefusedBeforeOpenExrAllocatesThem) {
   std::filesystem::remove(path), std::filesystem::remove(damaged);
 }
 
+// A run-length encoded Radiance scan line built by hand: R a run of 128s, G a dump of 0, 16, ...,
+// 112, B a run of 0s, E a run of 129, so each texel is (128, 16k, 0)·2^(129−136) = (1, k/8, 0).
+// A run of length 0 (stb_image loops forever on it) and a file cut inside the line are errors.
+TEST(HdrImageTest, RunLengthScanLinesDecodeAndHostileOnesAreRefused) {
+  const std::string header = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 8\n";
+  std::string line = {2, 2, 0, 8, static_cast<char>(128 + 8), static_cast<char>(128), 8};
+  for (int k = 0; k < 8; ++k) line += static_cast<char>(16 * k);
+  line += {static_cast<char>(128 + 8), 0, static_cast<char>(128 + 8), static_cast<char>(129)};
+  const auto path = Temp("rle.hdr");
+  std::ofstream(path, std::ios::binary) << header << line;
+  const HdrImage image = ReadHdrImage(path);
+  ASSERT_EQ(image.width, 8);
+  ASSERT_EQ(image.height, 1);
+  for (int k = 0; k < 8; ++k) {
+    EXPECT_EQ(image.Pixel(k, 0)[0], 1.0f) << k;
+    EXPECT_EQ(image.Pixel(k, 0)[1], static_cast<float>(k) / 8.0f) << k;
+    EXPECT_EQ(image.Pixel(k, 0)[2], 0.0f) << k;
+  }
+  const auto message = [&](const std::string& bytes) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+    try {
+      ReadHdrImage(path);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  std::string zero_run = line;
+  zero_run[4] = 0;  // R: a dump of 0 values
+  EXPECT_NE(message(header + zero_run).find("a run of 0 in scan line 0"), std::string::npos) << message(header + zero_run);
+  EXPECT_NE(message(header + line.substr(0, 12)).find("ends inside scan line 0"), std::string::npos);
+  std::filesystem::remove(path);
+}
+
 TEST(HdrImageTest, EnvMapChecksNameTheCause) {
   HdrImage image{64, 32, std::vector<float>(64 * 32 * 3, 1.0f)};
   EXPECT_NO_THROW(CheckEnvMap(image, "e.exr"));
