@@ -95,7 +95,7 @@ TEST(LiveDeviceTest, RecordWritesTheServedFramesAtTheirCaptureTimes) {
   for (cv::Mat& m : source) ASSERT_TRUE(video.read(m));
   double worst_match = 0.0, nearest_other = 1e9;
   for (size_t i = 0; i < 12; ++i) {
-    // Frame i is the i-th the device filled: its capture instant in UTC within 1 ms.
+    // Frame i is the i-th the device handed out: its capture instant in UTC within 1 ms.
     const double utc = UnixSeconds(ParseUtcTime(frames.rows[i][c_time], "frames.csv"));
     EXPECT_NEAR(utc, std::stod(served[i][3]), 1e-3) << "frame " << i;
     const cv::Mat image = cv::imread((out / "frames" / fmt::format("{:06d}.png", i)).string());
@@ -161,7 +161,7 @@ TEST(LiveDeviceTest, LiveCountsDroppedFramesAndSurvivesAnUnplug) {
   const nlohmann::json figures = nlohmann::json::parse(ReadTextFile(out / "figures.json"));
   EXPECT_EQ(figures.at("frames").get<int>(), 40);
   // daylit's count is the gaps in the sequence numbers of the frames it took, in the order the
-  // device filled its buffers (a new stream after the unplug starts again at 0). They include
+  // device handed them out (a new stream after the unplug starts again at 0). They include
   // every 7th sensor frame (lost on purpose) and any the device lost for want of a queued buffer
   // (a client slower than 30 fps).
   // daylit also took from the driver, and gave back unread, the frames that were waiting while

@@ -14,7 +14,7 @@
 //                           for S seconds, then the path is back
 //   DAYLIT_FAKECAM_STUCK    a control name (exposure, gain, white_balance) whose S_CTRL succeeds
 //                           but that keeps its old value, as some cameras' firmware does
-//   DAYLIT_FAKECAM_LOG      a CSV it appends to: one row per frame put in a buffer ("frame",
+//   DAYLIT_FAKECAM_LOG      a CSV it appends to: one row per frame handed out by DQBUF ("frame",
 //                           sequence, source frame, CLOCK_MONOTONIC and CLOCK_REALTIME at its
 //                           capture, format), per frame lost ("lost", sequence, why: injected or
 //                           no buffer queued) and per control write ("control", name, the value
@@ -86,6 +86,7 @@ struct Stream {
     bool queued = false;  // owned by the driver, empty
     bool done = false;    // filled, waiting for DQBUF
     v4l2_buffer info{};
+    std::string log_row;  // what the log says of its frame once it is handed out (DQBUF)
   };
   std::vector<Buffer> buffers;
   std::vector<uint32_t> done_order;  // filled buffers, oldest first
@@ -242,8 +243,8 @@ class FakeCamera {
       empty->info.timestamp.tv_usec = static_cast<suseconds_t>(std::lround((captured - std::floor(captured)) * 1e6));
       empty->info.flags = V4L2_BUF_FLAG_MAPPED | V4L2_BUF_FLAG_DONE | V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC | V4L2_BUF_FLAG_TSTAMP_SRC_SOE;
       s.done_order.push_back(empty->info.index);
-      Log(fmt("frame,%llu,%zu,%.6f,%.6f,%s", static_cast<unsigned long long>(sequence), source, captured,
-              real_now - (now - captured), s.fourcc == V4L2_PIX_FMT_YUYV ? "YUYV" : "MJPG"));
+      empty->log_row = fmt("frame,%llu,%zu,%.6f,%.6f,%s", static_cast<unsigned long long>(sequence), source, captured,
+                           real_now - (now - captured), s.fourcc == V4L2_PIX_FMT_YUYV ? "YUYV" : "MJPG");
     }
   }
 
@@ -445,6 +446,7 @@ int FakeCamera::Ioctl(int fd, unsigned long request, void* arg) {
         Stream::Buffer& done = s.buffers[s.done_order.front()];
         s.done_order.erase(s.done_order.begin());
         done.done = done.queued = false;
+        Log(done.log_row);
         *b = done.info;
         return 0;
       }
