@@ -19,9 +19,7 @@ CompositorOptions CompositorFor(const FrameRendererOptions& options, const scene
 
 FrameRenderer::FrameRenderer(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
                              const FrameRendererOptions& options)
-    : scene_(scene),
-      caster_(caster),
-      objects_model_(scene::ObjectsModel(scene.objects)),
+    : objects_model_(scene::ObjectsModel(scene.objects)),
       objects_(objects_model_),
       shadows_(scene, bake, caster, objects_),
       bounce_(scene, bake, caster, objects_),

@@ -41,7 +41,8 @@ int ParseLighting(const std::string& text, const char* where);
 
 class FrameRenderer {
  public:
-  // `caster` is over the scene's model; the renderer keeps references to all three.
+  // `caster` is over the scene's model; the renderer's parts keep references to all
+  // three.
   FrameRenderer(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
                 const FrameRendererOptions& options = {});
 
@@ -64,8 +65,6 @@ class FrameRenderer {
   // The objects' own radiance for a new sun, from the volume's parts (composite::ObjectLight).
   void UpdateObjectLight(const glm::vec3& sun_dir);
 
-  const scene::Scene& scene_;
-  const scene::RayCaster& caster_;
   scene::SceneModel objects_model_;  // before objects_, which keeps a reference to it
   scene::RayCaster objects_;
   composite::ObjectShadows shadows_;

@@ -9,10 +9,13 @@ build_dir=build
 cmake_args=(-DCMAKE_BUILD_TYPE=Release -DDAYLIT_WERROR=ON)
 if [ "${1:-}" = "--sanitize" ]; then
   build_dir=build-asan
-  # -g1: line tables for the sanitizers' stack traces, without full debug info (a third of the
-  # build's time on this template-heavy code).
+  # clang, as the fuzz targets are built (scripts/fuzz.sh); -O1 -g1: line tables for the
+  # sanitizers' stack traces, without full debug info (a third of the build's time on this
+  # template-heavy code).
+  export CC=clang CXX=clang++
   cmake_args=(-DCMAKE_BUILD_TYPE=RelWithDebInfo -DDAYLIT_WERROR=ON -DDAYLIT_SANITIZE=ON
-              -DDAYLIT_BUILD_BENCH=OFF "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1 -DNDEBUG")
+              -DDAYLIT_BUILD_BENCH=OFF "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG"
+              "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O1 -g1 -DNDEBUG")
 fi
 
 bash scripts/setup.sh

@@ -13,6 +13,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
@@ -763,13 +765,21 @@ TEST(CliTest, SigtermEndsAReplayWithCompleteOutputsAndNoTemporaries) {
   const fs::path stale = dir / ("r.mp4.tmp-" + std::to_string(DeadPid()) + "-0.mp4");
   WriteFileAtomically(stale, "half a video");
   const fs::path err = dir / "stderr.txt";
+  // Its environment: this one, with kGlEnvironment's ASAN_OPTIONS (it opens GL).
+  std::vector<std::string> env_text = {kGlEnvironment.substr(0, kGlEnvironment.size() - 1)};
+  for (char** e = environ; *e != nullptr; ++e) {
+    if (std::string(*e).rfind("ASAN_OPTIONS=", 0) != 0) env_text.emplace_back(*e);
+  }
+  std::vector<char*> env;
+  for (std::string& e : env_text) env.push_back(e.data());
+  env.push_back(nullptr);
   const pid_t child = ::fork();
   if (child == 0) {
     const int fd = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     ::dup2(fd, 2);
     const std::string cache = DAYLIT_BINARY_DIR "/test-cache/courtyard-a", out = (dir / "r.mp4").string();
-    ::execl(DAYLIT_BINARY_DIR "/bin/daylit", "daylit", "replay", kRecording.c_str(), "--cache", cache.c_str(), "--out",
-            out.c_str(), static_cast<char*>(nullptr));
+    ::execle(DAYLIT_BINARY_DIR "/bin/daylit", "daylit", "replay", kRecording.c_str(), "--cache", cache.c_str(), "--out",
+             out.c_str(), static_cast<char*>(nullptr), env.data());
     ::_exit(127);
   }
   // Once frames are going out (the progress line says fps), stop it.
