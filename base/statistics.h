@@ -16,4 +16,16 @@ T MedianInPlace(std::vector<T>& values, T if_empty) {
   return *middle;
 }
 
+// The value at fraction `q` (0..1) of `values` in order (index q·n, the last at most), reordering
+// them: q = 0.5 is MedianInPlace's median, q = 0.95 the 95th percentile. `if_empty` when there
+// are none.
+template <typename T>
+T PercentileInPlace(std::vector<T>& values, double q, T if_empty) {
+  if (values.empty()) return if_empty;
+  const size_t k = std::min(values.size() - 1, static_cast<size_t>(std::max(q, 0.0) * static_cast<double>(values.size())));
+  const auto at = values.begin() + static_cast<std::ptrdiff_t>(k);
+  std::nth_element(values.begin(), at, values.end());
+  return *at;
+}
+
 }  // namespace daylit

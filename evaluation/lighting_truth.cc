@@ -61,10 +61,7 @@ TruthComparison CompareWithTruth(const std::vector<estimation::FrameEstimate>& f
   std::vector<double> worst;
   std::copy_if(cmp.worst_channel_error.begin(), cmp.worst_channel_error.end(), std::back_inserter(worst),
                [](double e) { return !std::isnan(e); });
-  if (!worst.empty()) {
-    std::sort(worst.begin(), worst.end());
-    cmp.p90_worst_channel_error = worst[std::min(worst.size() - 1, static_cast<size_t>(0.9 * static_cast<double>(worst.size())))];
-  }
+  cmp.p90_worst_channel_error = PercentileInPlace(worst, 0.9, cmp.p90_worst_channel_error);
   std::vector<double> confidence;
   for (const estimation::FrameEstimate& f : frames) confidence.push_back(f.confidence);
   cmp.ranking = RankByConfidence(confidence, cmp.worst_channel_error);

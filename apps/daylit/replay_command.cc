@@ -63,11 +63,9 @@ void WriteReplayReport(const scene::Scene& scene, const pipeline::PipelineRun& r
   if (run.undecodable > 0) report.Say(fmt::format("  {} frames could not be decoded (shown as the frame before)", run.undecodable));
   if (live) {
     std::vector<double> latency = run.latency_ms;
-    std::sort(latency.begin(), latency.end());
-    const auto at = [&](double q) {
-      return latency.empty() ? NAN : latency[std::min(latency.size() - 1, static_cast<size_t>(q * static_cast<double>(latency.size())))];
-    };
-    const double median = at(0.5), p95 = at(0.95), worst = latency.empty() ? NAN : latency.back();
+    const double median = PercentileInPlace(latency, 0.5, static_cast<double>(NAN)),
+                 p95 = PercentileInPlace(latency, 0.95, static_cast<double>(NAN)),
+                 worst = PercentileInPlace(latency, 1.0, static_cast<double>(NAN));
     report.Say(fmt::format("  {} frames dropped by the camera's driver (gaps in its sequence numbers), {} skipped "
                            "(a newer one was waiting); a frame's age when estimated: median {:.0f} ms, 95th percentile "
                            "{:.0f} ms, worst {:.0f} ms (the first frame waits for the set-up)",
