@@ -41,8 +41,7 @@ int ParseLighting(const std::string& text, const char* where);
 
 class FrameRenderer {
  public:
-  // `caster` is over the scene's model; the renderer's parts keep references to all
-  // three.
+  // `caster` is over the scene's model; the renderer's parts keep references to all three.
   FrameRenderer(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
                 const FrameRendererOptions& options = {});
 
