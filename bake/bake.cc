@@ -331,7 +331,7 @@ cv::Mat LoadDiffuseMask(const scene::Scene& scene, const EnvMapMaps& env) {
 }  // namespace
 
 std::string BakeOptions::Check() const {
-  return FirstProblem({Nested("rays", rays.Check()), InClosed("gather_directions", gather_directions, 16, 65536),
+  return FirstProblem({Nested("rays", rays.Check()), InClosed("gather_directions", gather_directions, 16, kMaxGatherDirections),
                        Nested("detail", detail.Check())});
 }
 

@@ -22,6 +22,8 @@ namespace daylit::bake {
 inline constexpr uint32_t kNoSurface = 0xFFFFFFFFu;  // sky, or no point
 // Bumped whenever the bake computes something differently, so that old caches are re-baked.
 inline constexpr const char* kBakeFormat = "daylit-bake/8";
+// The most gather directions per probe a bake makes (BakeOptions::Check) or a cache may claim.
+inline constexpr int kMaxGatherDirections = 65536;
 
 struct BakeOptions {
   RayOptions rays;

@@ -116,7 +116,9 @@ void WritePreviews(const SceneBake& bake, const fs::path& dir) {
 }
 
 nlohmann::json Vec(const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
-glm::vec3 Vec(const nlohmann::json& j) { return {j[0].get<float>(), j[1].get<float>(), j[2].get<float>()}; }
+// at(), never operator[], on what is read: a missing key or index in a const json is an assertion
+// (or undefined behaviour), at() throws.
+glm::vec3 Vec(const nlohmann::json& j) { return {j.at(0).get<float>(), j.at(1).get<float>(), j.at(2).get<float>()}; }
 
 }  // namespace
 
@@ -284,7 +286,7 @@ void CheckLoadedBake(const SceneBake& bake, const nlohmann::json& j) {
   }
   const CameraGBuffer& g = bake.camera;
   const size_t pixels = static_cast<size_t>(g.width) * static_cast<size_t>(g.height);
-  const auto& camera = j["camera"];
+  const auto& camera = j.at("camera");
   if (g.width != camera.value("width", -1) || g.height != camera.value("height", -1)) {
     Damaged(fmt::format("camera_gbuffer.exr: {}x{}, not the camera's", g.width, g.height));
   }
@@ -319,13 +321,13 @@ void CheckLoadedBake(const SceneBake& bake, const nlohmann::json& j) {
 SceneBake ReadBake(const fs::path& dir, const std::string& hash, const nlohmann::json& j) {
   SceneBake bake;
   bake.hash = hash;
-  const auto& sun = j["capture_sun"];
-  bake.capture_sun.dir = Vec(sun["direction"]);
-  bake.capture_sun.above_horizon = sun["above_horizon"].get<bool>();
-  bake.capture_sun.dni_rgb = Vec(sun["dni_rgb"]);
-  bake.capture_sun.dni_from_map_rgb = Vec(sun["dni_from_map_rgb"]);
-  bake.capture_sun.disc_texels = sun["disc_texels"].get<size_t>();
-  bake.capture_sun.brightest_offset_deg = sun["brightest_offset_deg"].get<double>();
+  const auto& sun = j.at("capture_sun");
+  bake.capture_sun.dir = Vec(sun.at("direction"));
+  bake.capture_sun.above_horizon = sun.at("above_horizon").get<bool>();
+  bake.capture_sun.dni_rgb = Vec(sun.at("dni_rgb"));
+  bake.capture_sun.dni_from_map_rgb = Vec(sun.at("dni_from_map_rgb"));
+  bake.capture_sun.disc_texels = sun.at("disc_texels").get<size_t>();
+  bake.capture_sun.brightest_offset_deg = sun.at("brightest_offset_deg").get<double>();
   {
     scene::ExrChannels ch = scene::ReadExrChannels(
         dir / "env_maps.exr",
@@ -352,12 +354,17 @@ SceneBake ReadBake(const fs::path& dir, const std::string& hash, const nlohmann:
     g.surface = std::move(ch.uints[0]);
     g.env_texel = std::move(ch.uints[1]);
   }
-  const auto& gather = j["gather"];
-  bake.gather.min = Vec(gather["min"]);
-  bake.gather.max = Vec(gather["max"]);
-  bake.gather.resolution = {gather["resolution"][0].get<int>(), gather["resolution"][1].get<int>(), gather["resolution"][2].get<int>()};
-  const int directions = gather["directions"].get<int>();
+  const auto& gather = j.at("gather");
+  bake.gather.min = Vec(gather.at("min"));
+  bake.gather.max = Vec(gather.at("max"));
+  const auto& resolution = gather.at("resolution");
+  bake.gather.resolution = {resolution.at(0).get<int>(), resolution.at(1).get<int>(), resolution.at(2).get<int>()};
+  const int directions = gather.at("directions").get<int>();
+  if (directions > kMaxGatherDirections) Damaged(fmt::format("bake.json: {} gather directions (at most {})", directions, kMaxGatherDirections));
   if (directions > 0) {
+    for (int a = 0; a < 3; ++a) {  // the bounds scene.json's volume has (scene_loader.cc)
+      if (bake.gather.resolution[a] < 1 || bake.gather.resolution[a] > 256) Damaged(fmt::format("bake.json: gather resolution {}", resolution.dump()));
+    }
     bake.gather.directions = SphericalFibonacci(directions);
     bake.gather.texel = std::move(scene::ReadExrChannels(dir / "gather.exr", {}, {"texel"}).uints[0]);
     bake.gather.map_texels = static_cast<size_t>(bake.env.width) * static_cast<size_t>(bake.env.height);

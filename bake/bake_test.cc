@@ -4,9 +4,16 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "bake/synthetic_recording.h"
+#include "base/atomic_file.h"
+#include "base/csv.h"
 #include "base/error.h"
 #include "base/latlong.h"
 #include "scene/hdr_image.h"
@@ -256,6 +263,38 @@ TEST(BakeTest, ACachedGatherTableOutsideTheMapIsBakedAgain) {
   texel[17] = static_cast<uint32_t>(2 * bake.gather.map_texels - 1);  // the last one is fine
   scene::WriteExr(dir / "gather.exr", static_cast<int>(bake.gather.directions.size()), static_cast<int>(bake.gather.ProbeCount()),
                   {{"texel", scene::ExrPixelType::kUint, nullptr, texel.data()}});
+  EXPECT_TRUE(LoadBake(dir, hash).has_value());
+}
+
+// A bake.json with the right format and hash but a field missing, of the wrong type or out of
+// range is a damaged cache: baked again, never read past (fuzz/regressions/bake_cache).
+TEST(BakeTest, ABakeJsonWithAFieldMissingOrOutOfRangeIsBakedAgain) {
+  SyntheticRecording rec("bake_json_fields");
+  const scene::Scene scene = scene::LoadScene(rec.Write());
+  const BakeOptions options;
+  const std::filesystem::path dir = rec.dir / "cache";
+  SaveBake(RunBake(scene, options), scene, options, dir);
+  const std::string hash = BakeHash(scene, options);
+  const nlohmann::json pristine = nlohmann::json::parse(ReadTextFile(dir / "bake.json"));
+  ASSERT_TRUE(LoadBake(dir, hash).has_value());
+  const std::vector<std::pair<std::string, std::function<void(nlohmann::json&)>>> damage = {
+      {"no capture_sun", [](auto& j) { j.erase("capture_sun"); }},
+      {"no capture sun direction", [](auto& j) { j["capture_sun"].erase("direction"); }},
+      {"a two-element direction", [](auto& j) { j["capture_sun"]["direction"] = {0, 1}; }},
+      {"no camera", [](auto& j) { j.erase("camera"); }},
+      {"no gather", [](auto& j) { j.erase("gather"); }},
+      {"no gather resolution", [](auto& j) { j["gather"].erase("resolution"); }},
+      {"a gather resolution of zero", [](auto& j) { j["gather"]["resolution"][1] = 0; }},
+      {"two billion gather directions", [](auto& j) { j["gather"]["directions"] = 2000000000; }},
+      {"a string for directions", [](auto& j) { j["gather"]["directions"] = "many"; }},
+  };
+  for (const auto& [name, change] : damage) {
+    nlohmann::json j = pristine;
+    change(j);
+    WriteFileAtomically(dir / "bake.json", j.dump(1));
+    EXPECT_FALSE(LoadBake(dir, hash).has_value()) << name;
+  }
+  WriteFileAtomically(dir / "bake.json", pristine.dump(1));
   EXPECT_TRUE(LoadBake(dir, hash).has_value());
 }
 

@@ -59,7 +59,7 @@ run_one() {
        -artifact_prefix="$crashes/" -print_final_stats=0 "$corpus" "$seeds" >>"$out" 2>&1; then
     echo "fuzz_$name: $(grep -E '^Done [0-9]+ runs' "$out" | tail -n 1) (corpus $(ls "$corpus" | wc -l) inputs)"
   else
-    echo "fuzz_$name: FAILED: $(grep -E 'ERROR: |==ERROR|deadly signal|not an InputError' "$out" | head -n 1)" >&2
+    echo "fuzz_$name: FAILED: $(grep -E 'ERROR: |==ERROR|runtime error|Assertion|deadly signal|not an InputError' "$out" | head -n 1)" >&2
     echo "fuzz_$name: kept $(ls -t "$crashes" | head -n 1 | sed "s|^|$crashes/|"); log $out" >&2
     return 1
   fi
