@@ -79,7 +79,7 @@ void LightTransfer::Trace(const std::vector<uint32_t>& pixels) {
 // surface's median albedo, and V marked (−1) for FillHiddenSkyVisibility.
 LightTransfer::Bounce LightTransfer::BounceAt(const glm::vec3& y, const scene::RayHit& hit) const {
   const bake::EnvMapMaps& env = bake_.env;
-  Bounce b{y + options_.offset_m * hit.normal, hit.normal, glm::vec3(0.0f), -1.0f, hit.surface, 0};
+  Bounce b{y + options_.offset_m * hit.normal, hit.normal, glm::vec3(0.0f), -1.0f, hit.surface, 0, kNoCell};
   if (env.width > 0) {
     const glm::vec3 toward = y - capture_position_;
     const size_t texel = static_cast<size_t>(LatLongTexel(glm::dvec3(toward), env.width, env.height));
@@ -238,26 +238,45 @@ void LightTransfer::FillHiddenSkyVisibility(std::vector<TracedPixel>* traced) {
   }
 }
 
+// Serial only where the shared tables grow (each range's offsets, the ids of new orientations);
+// the copies, a hundred MB or more when the sun moves to a new burst, run in parallel.
 void LightTransfer::StorePaths(const std::vector<uint32_t>& fresh, const std::vector<TracedPixel>& traced) {
-  for (size_t k = 0; k < fresh.size(); ++k) {
-    const TracedPixel& pixel = traced[k];
-    Paths paths;
-    paths.orientation = OrientationOf(points_.normal[fresh[k]]);
-    paths.low_sky_begin = static_cast<uint32_t>(low_sky_.size());
-    low_sky_.insert(low_sky_.end(), pixel.low_sky.begin(), pixel.low_sky.end());
-    paths.low_sky_end = static_cast<uint32_t>(low_sky_.size());
-    paths.blocked_begin = static_cast<uint32_t>(blocked_.size());
-    blocked_.insert(blocked_.end(), pixel.blocked.begin(), pixel.blocked.end());
-    paths.blocked_end = static_cast<uint32_t>(blocked_.size());
-    paths.bounce_begin = static_cast<uint32_t>(bounces_.size());
-    for (Bounce b : pixel.bounces) {
-      b.orientation = OrientationOf(b.normal);
-      bounces_.push_back(b);
-    }
-    paths.bounce_end = static_cast<uint32_t>(bounces_.size());
-    slot_[fresh[k]] = static_cast<int32_t>(paths_.size());
-    paths_.push_back(paths);
+  const size_t n = fresh.size(), first_bounce = bounces_.size();
+  std::vector<Paths> paths(n);
+  size_t low = low_sky_.size(), blocked = blocked_.size(), bounces = first_bounce;
+  for (size_t k = 0; k < n; ++k) {
+    Paths& p = paths[k];
+    p.low_sky_begin = static_cast<uint32_t>(low), p.low_sky_end = static_cast<uint32_t>(low += traced[k].low_sky.size());
+    p.blocked_begin = static_cast<uint32_t>(blocked), p.blocked_end = static_cast<uint32_t>(blocked += traced[k].blocked.size());
+    p.bounce_begin = static_cast<uint32_t>(bounces), p.bounce_end = static_cast<uint32_t>(bounces += traced[k].bounces.size());
   }
+  // Room for what later sun moves add (a fifth of the first trace each, on the recordings): a
+  // vector that grows copies everything it holds, page by fresh page.
+  if (bounces > bounces_.capacity()) bounces_.reserve(2 * bounces);
+  low_sky_.resize(low), blocked_.resize(blocked), bounces_.resize(bounces);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t k = range.begin(); k != range.end(); ++k) {
+      const TracedPixel& pixel = traced[k];
+      std::copy(pixel.low_sky.begin(), pixel.low_sky.end(), low_sky_.begin() + paths[k].low_sky_begin);
+      std::copy(pixel.blocked.begin(), pixel.blocked.end(), blocked_.begin() + paths[k].blocked_begin);
+      Bounce* out = bounces_.data() + paths[k].bounce_begin;
+      for (const Bounce& b : pixel.bounces) {
+        *out = b;
+        (out++)->orientation = OrientationKey(b.normal);  // made an index below
+      }
+    }
+  });
+  uint32_t last_key = UINT32_MAX, last_index = 0;  // neighbouring hits mostly share a plane
+  for (size_t i = first_bounce; i < bounces_.size(); ++i) {
+    const uint32_t key = bounces_[i].orientation;
+    if (key != last_key) last_key = key, last_index = OrientationOfKey(key);
+    bounces_[i].orientation = last_index;
+  }
+  for (size_t k = 0; k < n; ++k) {
+    paths[k].orientation = OrientationOf(points_.normal[fresh[k]]);
+    slot_[fresh[k]] = static_cast<int32_t>(paths_.size() + k);
+  }
+  paths_.insert(paths_.end(), paths.begin(), paths.end());
 }
 
 float LightTransfer::CellEdge(uint32_t level) { return level == 1 ? kCellSize : kDeepCellScale * kCellSize; }
@@ -266,14 +285,22 @@ uint64_t LightTransfer::CellKey(const Bounce& b, uint32_t level) {
   return bake::SurfaceCellKey(b.point, b.normal, b.surface * 4ull + level, CellEdge(level));
 }
 
-uint32_t LightTransfer::OrientationOf(const glm::vec3& normal) {
-  const glm::ivec3 q(glm::round(normal * 64.0f));
-  const uint64_t key = (static_cast<uint64_t>(q.x + 64) << 16) | (static_cast<uint64_t>(q.y + 64) << 8) |
-                       static_cast<uint64_t>(q.z + 64);
+uint32_t LightTransfer::OrientationKey(const glm::vec3& normal) {
+  const glm::ivec3 q = glm::clamp(glm::ivec3(glm::round(normal * 64.0f)), -64, 64);
+  return (static_cast<uint32_t>(q.x + 64) << 16) | (static_cast<uint32_t>(q.y + 64) << 8) | static_cast<uint32_t>(q.z + 64);
+}
+
+uint32_t LightTransfer::OrientationOfKey(uint32_t key) {
   const auto [it, inserted] = orientation_of_.emplace(key, static_cast<uint32_t>(orientations_.size()));
-  if (inserted) orientations_.push_back(glm::normalize(glm::vec3(q)));
+  if (inserted) {
+    const glm::vec3 q(static_cast<float>(static_cast<int>(key >> 16) - 64), static_cast<float>(static_cast<int>((key >> 8) & 0xFF) - 64),
+                      static_cast<float>(static_cast<int>(key & 0xFF) - 64));
+    orientations_.push_back(glm::normalize(q));
+  }
   return it->second;
 }
+
+uint32_t LightTransfer::OrientationOf(const glm::vec3& normal) { return OrientationOfKey(OrientationKey(normal)); }
 
 std::vector<LightTransfer::OpenSky> LightTransfer::OpenSkyIntegrals(const glm::vec3& sun_dir,
                                                                       const glm::vec3& inv_dhi) const {

@@ -30,8 +30,12 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <new>
 #include <string>
+#include <type_traits>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -105,7 +109,25 @@ class LightTransfer {
     float sky_visibility;  // < 0 until known
     uint32_t surface;
     uint32_t orientation;      // index into orientations_
-    uint32_t cell = kNoCell;   // index into cells_: where its own reflected light comes from
+    uint32_t cell;             // index into cells_ (kNoCell: none): where its own reflected light comes from
+  };
+  // Trivial, so that growing bounces_ leaves the new elements for StorePaths' threads to write
+  // first (each fresh page faulted by one of them, not all of them by one thread).
+  static_assert(std::is_trivially_default_constructible_v<Bounce>);
+  template <typename T>
+  struct DefaultInitAllocator : std::allocator<T> {
+    template <typename U>
+    struct rebind {
+      using other = DefaultInitAllocator<U>;
+    };
+    template <typename U>
+    void construct(U* p) noexcept {
+      ::new (static_cast<void*>(p)) U;
+    }
+    template <typename U, typename... Args>
+    void construct(U* p, Args&&... args) {
+      ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
   };
   // A square of one side of a surface: the node of the radiosity solve.
   struct Cell {
@@ -165,6 +187,8 @@ class LightTransfer {
                           const ClearSky& sky, const std::vector<Transfer>& cell_light, Transfer* out,
                           Transfer* reflected) const;
   uint32_t OrientationOf(const glm::vec3& normal);  // index into orientations_, added if new
+  static uint32_t OrientationKey(const glm::vec3& normal);  // the normal quantised to ~1°
+  uint32_t OrientationOfKey(uint32_t key);                   // index into orientations_, added if new
   static constexpr float kCellSize = 0.5f;          // m, level-1 cells; deeper ones 4× that
   static float CellEdge(uint32_t level);                     // m
   static uint64_t CellKey(const Bounce& b, uint32_t level);  // bake::SurfaceCellKey at that level's size
@@ -181,9 +205,9 @@ class LightTransfer {
   std::vector<int32_t> slot_;       // per G-buffer pixel: index into paths_, −1 until traced
   std::vector<Paths> paths_;
   std::vector<glm::vec3> low_sky_, blocked_;
-  std::vector<Bounce> bounces_;
+  std::vector<Bounce, DefaultInitAllocator<Bounce>> bounces_;
   std::vector<glm::vec3> orientations_;  // distinct normals of pixels and bounce points (to ~1°)
-  std::unordered_map<uint64_t, uint32_t> orientation_of_;
+  std::unordered_map<uint32_t, uint32_t> orientation_of_;  // OrientationKey → index
   std::vector<Cell> cells_;
   std::vector<Bounce> cell_bounces_;              // the hits of each cell's rays
   std::vector<uint32_t> cell_sky_;                // the others' directions, packed
