@@ -245,7 +245,7 @@ CameraGBuffer ComputeCameraGBuffer(const scene::Scene& scene, const scene::RayCa
   });
   std::vector<uint8_t> has_point(n, 0);
   for (const size_t i : hit_pixels) has_point[i] = 1;
-  const std::vector<glm::vec3> detail = CameraTextureDetail(scene, g.point, has_point, env.height, options.detail);
+  const std::vector<glm::vec3> detail = CameraTextureDetail(scene, g.point, g.surface, has_point, env.height, options.detail);
   std::vector<uint8_t> is_diffuse_surface(scene.model.surface_names.size(), 0);
   for (const int s : scene.diffuse_surfaces) is_diffuse_surface[static_cast<size_t>(s)] = 1;
   for (size_t k = 0; k < hit_pixels.size(); ++k) {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <functional>
@@ -10,8 +11,10 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "bake/synthetic_recording.h"
+#include "bake/texture_detail.h"
 #include "base/atomic_file.h"
 #include "base/csv.h"
 #include "base/error.h"
@@ -296,6 +299,48 @@ TEST(BakeTest, ABakeJsonWithAFieldMissingOrOutOfRangeIsBakedAgain) {
   }
   WriteFileAtomically(dir / "bake.json", pristine.dump(1));
   EXPECT_TRUE(LoadBake(dir, hash).has_value());
+}
+
+// Texture detail D = I / blur(I) is relative to the pixel's own surface: a box reaching over an
+// edge into a brighter surface made D, and the camera albedo, too low along the edge
+// (courtyard-c's far ground, a strip under a white building: −7.2% in green). Hand-built: a
+// striped surface (rows alternating between two codes) beside a bright one, seen straight down;
+// at the edge and in the interior, D is the stripes' own ratio 5a / (3a + 2b) for the 5-pixel box
+// both use there (a texel of π/12 at 1.5–1.7 m from the capture point, ×1.5, seen from 5 m).
+TEST(BakeTest, TextureDetailIsRelativeToThePixelsOwnSurface) {
+  SyntheticRecording rec("detail_edge");
+  rec.env_width = 24;
+  rec.obj = "o striped\nv -100 -100 0\nv 0 -100 0\nv 0 100 0\nv -100 100 0\nf 1 2 3 4\n"
+            "o bright\nv 0 -100 0\nv 100 -100 0\nv 100 100 0\nv 0 100 0\nf 1 2 3 4\n";
+  rec.scene["diffuse_surfaces"] = {"striped", "bright"};
+  const scene::Scene scene = scene::LoadScene(rec.Write());
+  // Camera x is world x (cx = 31.5): columns 0–31 see the striped surface, 32–63 the bright one.
+  constexpr uint8_t kA = 100, kB = 60, kBright = 230;
+  cv::Mat frame(48, 64, CV_8UC3);
+  for (int v = 0; v < 48; ++v) {
+    for (int u = 0; u < 64; ++u) frame.at<cv::Vec3b>(v, u) = cv::Vec3b::all(u >= 32 ? kBright : (v % 2 ? kB : kA));
+  }
+  ASSERT_TRUE(cv::imwrite((rec.dir / "frames" / "000000.png").string(), frame));
+  std::vector<glm::vec3> points(64 * 48);
+  std::vector<uint32_t> surface(points.size());
+  for (int v = 0; v < 48; ++v) {
+    for (int u = 0; u < 64; ++u) {  // the ground point under pixel (u, v), 5 m below the camera
+      const size_t i = static_cast<size_t>(v) * 64 + u;
+      points[i] = glm::vec3(5.0f * (static_cast<float>(u) - 31.5f) / 40.0f, -5.0f * (static_cast<float>(v) - 23.5f) / 40.0f, 0.0f);
+      surface[i] = u >= 32 ? 1 : 0;
+    }
+  }
+  const std::vector<glm::vec3> d = CameraTextureDetail(scene, points, surface, std::vector<uint8_t>(points.size(), 1), 12, DetailOptions{});
+  const std::array<float, 256> lut = scene.response.LinearLut8(1);
+  for (int v = 18; v < 30; ++v) {  // the rows where both columns use the 5-pixel box
+    const size_t row = static_cast<size_t>(v) * 64;
+    const float a = lut[v % 2 ? kB : kA], b = lut[v % 2 ? kA : kB];
+    const float expected = 5.0f * a / (3.0f * a + 2.0f * b);
+    for (const int u : {28, 31}) {  // interior, and the column next to the bright surface
+      EXPECT_NEAR(d[row + static_cast<size_t>(u)].y, expected, 0.01f * expected) << "row " << v << " column " << u;
+    }
+    EXPECT_NEAR(d[row + 32].y, 1.0f, 0.01f) << "row " << v;  // the bright side's edge: flat
+  }
 }
 
 }  // namespace

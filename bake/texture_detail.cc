@@ -78,39 +78,84 @@ std::vector<int8_t> BoxPerPixel(const scene::Scene& scene, const std::vector<glm
   return box;
 }
 
-// One linear frame's I / blur(I) per pixel and channel, with the pixel's own box, added to
-// `samples` (channels in BGR order, as OpenCV's). NaN-aware box means: the values blurred with
-// NaN as 0, divided by the blurred validity.
-void AddFrameDetail(const cv::Mat& linear, const std::vector<int8_t>& box, const std::array<bool, kBoxSizes.size()>& used,
-                    std::vector<std::array<std::vector<float>, 3>>* samples) {
-  const int w = linear.cols, h = linear.rows;
-  cv::Mat valid(linear.size(), CV_32FC3), values = linear.clone();
-  for (int y = 0; y < h; ++y) {
-    cv::Vec3f* v = values.ptr<cv::Vec3f>(y);
-    cv::Vec3f* m = valid.ptr<cv::Vec3f>(y);
-    for (int x = 0; x < w; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        m[x][c] = std::isnan(v[x][c]) ? 0.0f : 1.0f;
-        if (std::isnan(v[x][c])) v[x][c] = 0.0f;
+// The pixels of one surface, the boxes they use, and the rectangle they and their boxes cover.
+struct SurfacePixels {
+  uint32_t surface = 0;
+  std::array<bool, kBoxSizes.size()> used{};
+  cv::Rect rect;  // the surface's pixels' bounding box grown by its largest box's half width
+};
+
+std::vector<SurfacePixels> GroupBySurface(const std::vector<uint32_t>& surface, const std::vector<int8_t>& box, int w, int h) {
+  std::vector<SurfacePixels> groups;
+  std::vector<int> group_of;  // surface id → index into groups, −1: none yet
+  std::vector<cv::Point> low, high;
+  for (size_t i = 0; i < box.size(); ++i) {
+    if (box[i] < 0) continue;
+    if (surface[i] >= group_of.size()) group_of.resize(surface[i] + 1, -1);
+    int& g = group_of[surface[i]];
+    const int x = static_cast<int>(i % static_cast<size_t>(w)), y = static_cast<int>(i / static_cast<size_t>(w));
+    if (g < 0) {
+      g = static_cast<int>(groups.size());
+      groups.push_back({surface[i], {}, {}});
+      low.emplace_back(x, y), high.emplace_back(x, y);
+    }
+    groups[static_cast<size_t>(g)].used[static_cast<size_t>(box[i])] = true;
+    low[static_cast<size_t>(g)] = {std::min(low[static_cast<size_t>(g)].x, x), std::min(low[static_cast<size_t>(g)].y, y)};
+    high[static_cast<size_t>(g)] = {std::max(high[static_cast<size_t>(g)].x, x), std::max(high[static_cast<size_t>(g)].y, y)};
+  }
+  for (size_t g = 0; g < groups.size(); ++g) {
+    int reach = 0;
+    for (size_t b = 0; b < kBoxSizes.size(); ++b) {
+      if (groups[g].used[b]) reach = kBoxSizes[b] / 2;
+    }
+    const cv::Point a(std::max(0, low[g].x - reach), std::max(0, low[g].y - reach));
+    const cv::Point z(std::min(w, high[g].x + reach + 1), std::min(h, high[g].y + reach + 1));
+    groups[g].rect = cv::Rect(a, z);
+  }
+  return groups;
+}
+
+// One linear frame's I / blur(I) per pixel and channel, with the pixel's own box over its own
+// surface's pixels, added to `samples` (channels in BGR order, as OpenCV's). Masked box means:
+// the values blurred with NaN and other surfaces as 0, divided by the blurred mask.
+void AddFrameDetail(const cv::Mat& linear, const std::vector<uint32_t>& surface, const std::vector<int8_t>& box,
+                    const std::vector<SurfacePixels>& groups, std::vector<std::array<std::vector<float>, 3>>* samples) {
+  const int w = linear.cols;
+  for (const SurfacePixels& group : groups) {
+    const cv::Rect& r = group.rect;
+    cv::Mat values(r.size(), CV_32FC3), valid(r.size(), CV_32FC3);
+    for (int y = 0; y < r.height; ++y) {
+      const cv::Vec3f* l = linear.ptr<cv::Vec3f>(r.y + y) + r.x;
+      cv::Vec3f* v = values.ptr<cv::Vec3f>(y);
+      cv::Vec3f* m = valid.ptr<cv::Vec3f>(y);
+      for (int x = 0; x < r.width; ++x) {
+        const size_t i = static_cast<size_t>(r.y + y) * w + static_cast<size_t>(r.x + x);
+        const bool own = box[i] >= 0 && surface[i] == group.surface;
+        for (int c = 0; c < 3; ++c) {
+          const bool ok = own && !std::isnan(l[x][c]);
+          m[x][c] = ok ? 1.0f : 0.0f;
+          v[x][c] = ok ? l[x][c] : 0.0f;
+        }
       }
     }
-  }
-  for (size_t b = 0; b < kBoxSizes.size(); ++b) {
-    if (!used[b]) continue;
-    cv::Mat sum, weight;
-    const cv::Size size(kBoxSizes[b], kBoxSizes[b]);
-    cv::blur(values, sum, size, cv::Point(-1, -1), cv::BORDER_REFLECT);
-    cv::blur(valid, weight, size, cv::Point(-1, -1), cv::BORDER_REFLECT);
-    for (int y = 0; y < h; ++y) {
-      const cv::Vec3f* l = linear.ptr<cv::Vec3f>(y);
-      const cv::Vec3f* s = sum.ptr<cv::Vec3f>(y);
-      const cv::Vec3f* wt = weight.ptr<cv::Vec3f>(y);
-      for (int x = 0; x < w; ++x) {
-        const size_t i = static_cast<size_t>(y) * w + x;
-        if (box[i] != static_cast<int8_t>(b)) continue;
-        for (int c = 0; c < 3; ++c) {
-          const float mean = wt[x][c] > 0.5f ? s[x][c] / wt[x][c] : 0.0f;
-          if (!std::isnan(l[x][c]) && mean > 1e-4f) (*samples)[i][static_cast<size_t>(2 - c)].push_back(l[x][c] / mean);
+    for (size_t b = 0; b < kBoxSizes.size(); ++b) {
+      if (!group.used[b]) continue;
+      cv::Mat sum, weight;
+      const cv::Size size(kBoxSizes[b], kBoxSizes[b]);
+      cv::blur(values, sum, size, cv::Point(-1, -1), cv::BORDER_CONSTANT);
+      cv::blur(valid, weight, size, cv::Point(-1, -1), cv::BORDER_CONSTANT);
+      for (int y = 0; y < r.height; ++y) {
+        const cv::Vec3f* l = linear.ptr<cv::Vec3f>(r.y + y) + r.x;
+        const cv::Vec3f* s = sum.ptr<cv::Vec3f>(y);
+        const cv::Vec3f* wt = weight.ptr<cv::Vec3f>(y);
+        for (int x = 0; x < r.width; ++x) {
+          const size_t i = static_cast<size_t>(r.y + y) * w + static_cast<size_t>(r.x + x);
+          if (box[i] != static_cast<int8_t>(b) || surface[i] != group.surface) continue;
+          for (int c = 0; c < 3; ++c) {
+            if (std::isnan(l[x][c]) || !(wt[x][c] > 0.0f)) continue;
+            const float mean = s[x][c] / wt[x][c];
+            if (mean > 1e-4f) (*samples)[i][static_cast<size_t>(2 - c)].push_back(l[x][c] / mean);
+          }
         }
       }
     }
@@ -120,8 +165,8 @@ void AddFrameDetail(const cv::Mat& linear, const std::vector<int8_t>& box, const
 }  // namespace
 
 std::vector<glm::vec3> CameraTextureDetail(const scene::Scene& scene, const std::vector<glm::vec3>& points,
-                                           const std::vector<uint8_t>& has_point, int env_height,
-                                           const DetailOptions& options) {
+                                           const std::vector<uint32_t>& surface, const std::vector<uint8_t>& has_point,
+                                           int env_height, const DetailOptions& options) {
   const int w = scene.intrinsics.width, h = scene.intrinsics.height;
   std::vector<glm::vec3> detail(static_cast<size_t>(w) * h, glm::vec3(1.0f));
   if (!scene.frame_times || scene.frame_times->frames.empty() || options.frames <= 0) return detail;
@@ -134,12 +179,13 @@ std::vector<glm::vec3> CameraTextureDetail(const scene::Scene& scene, const std:
   const std::vector<cv::Mat> frames = ReadFrames(scene, indices);
   std::array<bool, kBoxSizes.size()> used{};
   const std::vector<int8_t> box = BoxPerPixel(scene, points, has_point, env_height, options.footprint_scale, &used);
+  const std::vector<SurfacePixels> groups = GroupBySurface(surface, box, w, h);
   std::vector<std::array<std::vector<float>, 3>> samples(detail.size());
   size_t decoded = 0;
   for (const cv::Mat& frame : frames) {
     if (frame.empty() || frame.cols != w || frame.rows != h) continue;
     ++decoded;
-    AddFrameDetail(Linearize(frame, scene.response), box, used, &samples);
+    AddFrameDetail(Linearize(frame, scene.response), surface, box, groups, &samples);
   }
   if (decoded == 0) {
     Log().warn("{}: no frame could be read: camera albedo keeps the env map's resolution", scene.file.string());

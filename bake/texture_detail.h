@@ -8,8 +8,8 @@
 // drops them.
 #pragma once
 
+#include <cstdint>
 #include <string>
-
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -26,9 +26,12 @@ struct DetailOptions {
 };
 
 // D for every camera pixel (1 where unknown: no model point, no frames, too few usable samples).
-// `points` and `has_point` are the G-buffer's; `env_height` is the env map's height (rows over π).
+// `points`, `surface` and `has_point` are the G-buffer's; `env_height` is the env map's height
+// (rows over π). blur(I) is over the pixel's own surface only: the env albedo it multiplies is
+// (EnvAlbedoAt), and a box reaching into a brighter neighbour (a sunlit wall, the sky-lit far
+// ground under a white building) made D, and the albedo, too low along every edge.
 std::vector<glm::vec3> CameraTextureDetail(const scene::Scene& scene, const std::vector<glm::vec3>& points,
-                                           const std::vector<uint8_t>& has_point, int env_height,
-                                           const DetailOptions& options);
+                                           const std::vector<uint32_t>& surface, const std::vector<uint8_t>& has_point,
+                                           int env_height, const DetailOptions& options);
 
 }  // namespace daylit::bake
