@@ -111,11 +111,77 @@ TEST(TransferTest, OneBounceOffASunlitWallMatchesItsViewFactor) {
 }
 
 // An arcade's back wall in the roof's shadow, lit by the sunlit ground in front, the roof's
-// underside (which that ground lights) and the low sky: daylit's three bounces against a
+// underside (which that ground lights) and the low sky: daylit with three bounces against a
 // brute-force path tracer with the same albedos and the same sky, per part of the light. The
 // sky is brightest around the sun, which stands low in front of the arcade, so the sky that the
 // bounce points under the roof see is much brighter than their hemisphere's average.
 TEST(TransferTest, ArcadeBackWallMatchesAPathTracerPerPartOfTheLight) {
+  // The afternoon sun at (0°, 0°), 27° up in the west-north-west, in front of the arcade: where
+  // the ephemeris puts it (a first bake tells), with the sky's aureole around it.
+  const char* capture = "2026-06-21T16:00:00Z";
+  const glm::vec3 sun = WallView(nullptr, true, capture).bake.capture_sun.dir;
+  ASSERT_LT(sun.x, -0.5f);
+  const auto sky_law = [sun](const glm::dvec3& d) {
+    const float c = std::max(0.0f, glm::dot(glm::vec3(d), sun));
+    return d.z > 0.0 ? glm::vec3(1.0f + 6.0f * std::pow(c, 8.0f)) : glm::vec3(0.0f);
+  };
+  WallView w(sky_law, true, capture);
+  // Known albedos everywhere (the map's own would be those of a scene lit by this sky alone).
+  const std::vector<glm::vec3> albedo = {glm::vec3(0.5f, 0.4f, 0.3f), glm::vec3(0.5f), glm::vec3(0.7f, 0.6f, 0.5f)};
+  for (size_t s = 0; s < albedo.size(); ++s) w.bake.albedo_table[s].albedo = albedo[s];
+  for (size_t t = 0; t < w.bake.env.surface.size(); ++t) {
+    if (!w.bake.env.IsSky(t)) w.bake.env.albedo[t] = albedo[w.bake.env.surface[t]];
+  }
+  TransferOptions three;  // the paths below are as deep
+  three.bounces = 3;
+  LightTransfer transfer(w.bake, TransferPoints::Camera(w.bake.camera), glm::vec3(w.scene.envmap->position), *w.caster, three);
+  std::vector<uint32_t> wall;
+  for (const uint32_t p : w.PixelsOf(1)) {
+    const glm::vec3& x = w.bake.camera.point[p];
+    if (std::abs(x.y) < 1.5f && x.z > 0.3f && x.z < 2.7f && p % 7 == 0) wall.push_back(p);
+  }
+  ASSERT_GT(wall.size(), 50u);
+  std::vector<float> direct(w.bake.camera.surface.size(), 0.0f);  // the roof shades the whole wall
+  std::vector<Transfer> t(wall.size());
+  transfer.Compute(wall, sun, direct.data(), t.data());
+  // The path tracer's skies per unit DHI: the table daylit evaluates for this sun, and a uniform one.
+  const bake::SkyDistribution table = bake::CapturedSky(w.bake);  // about `sun`, the capture sun
+  const glm::vec3 inv_dhi(1.0 / table.HorizontalIrradiance(sun));
+  const auto clear = [&](const glm::vec3& d) { return d.z > 0.0f ? table.Radiance(d, sun) * inv_dhi : glm::vec3(0.0f); };
+  const auto uniform = [](const glm::vec3& d) { return glm::vec3(d.z > 0.0f ? glm::one_over_pi<float>() : 0.0f); };
+  const auto none = [](const glm::vec3&) { return glm::vec3(0.0f); };
+  testing::ReferenceLight sun_only{sun, glm::vec3(1.0f), none, albedo};
+  testing::ReferenceLight clear_only{sun, glm::vec3(0.0f), clear, albedo};
+  testing::ReferenceLight overcast_only{sun, glm::vec3(0.0f), uniform, albedo};
+  glm::dvec3 daylit_sum[3] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
+  glm::dvec3 traced_sum[3] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
+  // Paths as deep as daylit's three bounces: the sun at up to three hits, the sky after them.
+  std::mt19937 rng(7);
+  for (size_t k = 0; k < wall.size(); ++k) {
+    const glm::vec3& x = w.bake.camera.point[wall[k]];
+    const glm::vec3& n = w.bake.camera.normal[wall[k]];
+    traced_sum[0] += glm::dvec3(testing::PathTracedIndirectAndSky(*w.caster, sun_only, x, n, 512, 3, rng));
+    traced_sum[1] += glm::dvec3(testing::PathTracedIndirectAndSky(*w.caster, clear_only, x, n, 256, 4, rng));
+    traced_sum[2] += glm::dvec3(testing::PathTracedIndirectAndSky(*w.caster, overcast_only, x, n, 256, 4, rng));
+    daylit_sum[0] += glm::dvec3(t[k].sun), daylit_sum[1] += glm::dvec3(t[k].clear), daylit_sum[2] += glm::dvec3(t[k].overcast);
+  }
+  const char* part[3] = {"sun", "clear sky", "overcast sky"};
+  for (int i = 0; i < 3; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      // Measured: sun 1.002-1.003, clear sky 1.008-1.017, overcast 1.028-1.036 (V of bounce points
+      // from the 256×128 map's texels and 25 cm cells, where V changes fast under the roof's edge).
+      EXPECT_NEAR(daylit_sum[i][c] / traced_sum[i][c], 1.0, i == 0 ? 0.02 : 0.04) << part[i] << " channel " << c;
+    }
+  }
+}
+
+// The same wall against paths of any length (12 hits): what the truncation leaves out. Under the
+// arcade most of the light has bounced between the sunlit ground (red albedo 0.5) and the roof
+// (0.7), so the series converges slowly and truncates worst in red. Measured, red: with 3 bounces
+// the sun part 0.911 and the clear sky 0.961 of the full paths (courtyard-c's arcade bursts took the
+// missing red as sky: E_sky red 5.1% high in burst 1); with 4, the default, 0.938 and 0.980; with 5,
+// 0.948 and 0.987.
+TEST(TransferTest, ArcadeBackWallAgainstPathsOfAnyLength) {
   // The afternoon sun at (0°, 0°), 27° up in the west-north-west, in front of the arcade: where
   // the ephemeris puts it (a first bake tells), with the sky's aureole around it.
   const char* capture = "2026-06-21T16:00:00Z";
@@ -153,22 +219,21 @@ TEST(TransferTest, ArcadeBackWallMatchesAPathTracerPerPartOfTheLight) {
   testing::ReferenceLight overcast_only{sun, glm::vec3(0.0f), uniform, albedo};
   glm::dvec3 daylit_sum[3] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
   glm::dvec3 traced_sum[3] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
-  // Paths as deep as daylit's three bounces: the sun at up to three hits, the sky after them.
   std::mt19937 rng(7);
   for (size_t k = 0; k < wall.size(); ++k) {
     const glm::vec3& x = w.bake.camera.point[wall[k]];
     const glm::vec3& n = w.bake.camera.normal[wall[k]];
-    traced_sum[0] += glm::dvec3(testing::PathTracedIndirectAndSky(*w.caster, sun_only, x, n, 512, 3, rng));
-    traced_sum[1] += glm::dvec3(testing::PathTracedIndirectAndSky(*w.caster, clear_only, x, n, 256, 4, rng));
-    traced_sum[2] += glm::dvec3(testing::PathTracedIndirectAndSky(*w.caster, overcast_only, x, n, 256, 4, rng));
+    traced_sum[0] += glm::dvec3(testing::PathTracedIndirectAndSky(*w.caster, sun_only, x, n, 512, 12, rng));
+    traced_sum[1] += glm::dvec3(testing::PathTracedIndirectAndSky(*w.caster, clear_only, x, n, 256, 12, rng));
+    traced_sum[2] += glm::dvec3(testing::PathTracedIndirectAndSky(*w.caster, overcast_only, x, n, 256, 12, rng));
     daylit_sum[0] += glm::dvec3(t[k].sun), daylit_sum[1] += glm::dvec3(t[k].clear), daylit_sum[2] += glm::dvec3(t[k].overcast);
   }
   const char* part[3] = {"sun", "clear sky", "overcast sky"};
   for (int i = 0; i < 3; ++i) {
     for (int c = 0; c < 3; ++c) {
-      // Measured: sun 1.002-1.003, clear sky 1.008-1.017, overcast 1.028-1.036 (V of bounce points
-      // from the 256×128 map's texels and 25 cm cells, where V changes fast under the roof's edge).
-      EXPECT_NEAR(daylit_sum[i][c] / traced_sum[i][c], 1.0, i == 0 ? 0.02 : 0.04) << part[i] << " channel " << c;
+      // Measured with 4 bounces: sun 0.938-0.969, clear sky 0.980-1.002, overcast 1.001-1.020.
+      // Three bounces fail both the sun's and the clear sky's bars in red.
+      EXPECT_NEAR(daylit_sum[i][c] / traced_sum[i][c], 1.0, i == 0 ? 0.07 : 0.03) << part[i] << " channel " << c;
     }
   }
 }
