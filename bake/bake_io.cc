@@ -362,8 +362,10 @@ SceneBake ReadBake(const fs::path& dir, const std::string& hash, const nlohmann:
   const int directions = gather.at("directions").get<int>();
   if (directions > kMaxGatherDirections) Damaged(fmt::format("bake.json: {} gather directions (at most {})", directions, kMaxGatherDirections));
   if (directions > 0) {
-    for (int a = 0; a < 3; ++a) {  // the bounds scene.json's volume has (scene_loader.cc)
-      if (bake.gather.resolution[a] < 1 || bake.gather.resolution[a] > 256) Damaged(fmt::format("bake.json: gather resolution {}", resolution.dump()));
+    for (int a = 0; a < 3; ++a) {  // the bounds scene.json's volume has
+      if (bake.gather.resolution[a] < 1 || bake.gather.resolution[a] > scene::kMaxVolumeResolution) {
+        Damaged(fmt::format("bake.json: gather resolution {}", resolution.dump()));
+      }
     }
     bake.gather.directions = SphericalFibonacci(directions);
     bake.gather.texel = std::move(scene::ReadExrChannels(dir / "gather.exr", {}, {"texel"}).uints[0]);

@@ -57,10 +57,9 @@ std::vector<cv::Mat> ReadFrames(const scene::Scene& scene, const std::vector<int
 }
 
 // Which box each pixel uses (an index into kBoxSizes; −1: no point): an env texel (π/H rad
-// seen from the capture point) in camera pixels. `used` marks the sizes some pixel uses.
+// seen from the capture point) in camera pixels.
 std::vector<int8_t> BoxPerPixel(const scene::Scene& scene, const std::vector<glm::vec3>& points,
-                                const std::vector<uint8_t>& has_point, int env_height, float footprint_scale,
-                                std::array<bool, kBoxSizes.size()>* used) {
+                                const std::vector<uint8_t>& has_point, int env_height, float footprint_scale) {
   const glm::vec3 capture(scene.envmap->position);
   const glm::vec3 center(scene.Camera().CenterInWorld());
   const float texel_rad = glm::pi<float>() / static_cast<float>(env_height);
@@ -73,7 +72,6 @@ std::vector<int8_t> BoxPerPixel(const scene::Scene& scene, const std::vector<glm
     size_t b = 0;
     while (b + 1 < kBoxSizes.size() && static_cast<float>(kBoxSizes[b + 1]) <= pixels + 1.0f) ++b;
     box[i] = static_cast<int8_t>(b);
-    (*used)[b] = true;
   }
   return box;
 }
@@ -88,29 +86,23 @@ struct SurfacePixels {
 std::vector<SurfacePixels> GroupBySurface(const std::vector<uint32_t>& surface, const std::vector<int8_t>& box, int w, int h) {
   std::vector<SurfacePixels> groups;
   std::vector<int> group_of;  // surface id → index into groups, −1: none yet
-  std::vector<cv::Point> low, high;
   for (size_t i = 0; i < box.size(); ++i) {
     if (box[i] < 0) continue;
     if (surface[i] >= group_of.size()) group_of.resize(surface[i] + 1, -1);
     int& g = group_of[surface[i]];
-    const int x = static_cast<int>(i % static_cast<size_t>(w)), y = static_cast<int>(i / static_cast<size_t>(w));
-    if (g < 0) {
-      g = static_cast<int>(groups.size());
-      groups.push_back({surface[i], {}, {}});
-      low.emplace_back(x, y), high.emplace_back(x, y);
-    }
-    groups[static_cast<size_t>(g)].used[static_cast<size_t>(box[i])] = true;
-    low[static_cast<size_t>(g)] = {std::min(low[static_cast<size_t>(g)].x, x), std::min(low[static_cast<size_t>(g)].y, y)};
-    high[static_cast<size_t>(g)] = {std::max(high[static_cast<size_t>(g)].x, x), std::max(high[static_cast<size_t>(g)].y, y)};
+    const cv::Rect pixel(static_cast<int>(i % static_cast<size_t>(w)), static_cast<int>(i / static_cast<size_t>(w)), 1, 1);
+    if (g < 0) g = static_cast<int>(groups.size()), groups.push_back({surface[i], {}, pixel});
+    SurfacePixels& group = groups[static_cast<size_t>(g)];
+    group.used[static_cast<size_t>(box[i])] = true;
+    group.rect |= pixel;
   }
-  for (size_t g = 0; g < groups.size(); ++g) {
+  for (SurfacePixels& group : groups) {
     int reach = 0;
     for (size_t b = 0; b < kBoxSizes.size(); ++b) {
-      if (groups[g].used[b]) reach = kBoxSizes[b] / 2;
+      if (group.used[b]) reach = kBoxSizes[b] / 2;
     }
-    const cv::Point a(std::max(0, low[g].x - reach), std::max(0, low[g].y - reach));
-    const cv::Point z(std::min(w, high[g].x + reach + 1), std::min(h, high[g].y + reach + 1));
-    groups[g].rect = cv::Rect(a, z);
+    const cv::Rect& r = group.rect;
+    group.rect = cv::Rect(r.x - reach, r.y - reach, r.width + 2 * reach, r.height + 2 * reach) & cv::Rect(0, 0, w, h);
   }
   return groups;
 }
@@ -177,8 +169,7 @@ std::vector<glm::vec3> CameraTextureDetail(const scene::Scene& scene, const std:
     if (indices.empty() || i > indices.back()) indices.push_back(std::min(i, count - 1));
   }
   const std::vector<cv::Mat> frames = ReadFrames(scene, indices);
-  std::array<bool, kBoxSizes.size()> used{};
-  const std::vector<int8_t> box = BoxPerPixel(scene, points, has_point, env_height, options.footprint_scale, &used);
+  const std::vector<int8_t> box = BoxPerPixel(scene, points, has_point, env_height, options.footprint_scale);
   const std::vector<SurfacePixels> groups = GroupBySurface(surface, box, w, h);
   std::vector<std::array<std::vector<float>, 3>> samples(detail.size());
   size_t decoded = 0;

@@ -69,6 +69,8 @@ struct VolumeSpec {
   glm::ivec3 resolution{2};       // probes per axis, each ≥ 2
   bool defaulted = false;         // true when derived from the objects
 };
+// The most probes a volume may have along one axis (scene.json, and a bake cache's gather tables).
+inline constexpr int kMaxVolumeResolution = 256;
 
 struct GroundTruthSpec {
   std::optional<std::filesystem::path> lighting;    // groundtruth.csv

@@ -345,8 +345,8 @@ void LoadVolume(const JsonField& root, Scene* scene) {
   if (r.size() != 3) resolution.Fail(fmt::format("expected 3 integers, got {}", r.size()));
   for (int a = 0; a < 3; ++a) {
     v.resolution[a] = r[static_cast<size_t>(a)].Integer();
-    if (v.resolution[a] < 1 || v.resolution[a] > 256) {
-      r[static_cast<size_t>(a)].Fail(fmt::format("{} is outside [1, 256]", v.resolution[a]));
+    if (v.resolution[a] < 1 || v.resolution[a] > kMaxVolumeResolution) {
+      r[static_cast<size_t>(a)].Fail(fmt::format("{} is outside [1, {}]", v.resolution[a], kMaxVolumeResolution));
     }
   }
   // Each probe gathers 512 rays in the bake and 512 texels every frame.
