@@ -411,8 +411,9 @@ std::vector<Transfer> LightTransfer::SolveCells(const glm::vec3& sun_dir, const 
     }
   });
   const float inv_rays = 1.0f / static_cast<float>(options_.cell_rays);
-  std::vector<Transfer> light(cells_.size()), next(cells_.size());
+  std::vector<Transfer> light(cells_.size()), next(cells_.size()), before(cells_.size()), before2(cells_.size());
   for (int pass = 1; pass < options_.bounces; ++pass) {
+    before2.swap(before), before = light;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, cells_.size(), 64), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t c = range.begin(); c != range.end(); ++c) {
         Transfer sum;
@@ -430,7 +431,30 @@ std::vector<Transfer> LightTransfer::SolveCells(const glm::vec3& sun_dir, const 
     });
     light.swap(next);
   }
+  if (options_.close_series && options_.bounces >= 3) CloseGeometricSeries(before2, before, &light);
   return light;
+}
+
+void CloseGeometricSeries(const std::vector<Transfer>& two_back, const std::vector<Transfer>& one_back,
+                          std::vector<Transfer>* light) {
+  glm::dvec3 last[3] = {}, previous[3] = {};
+  for (size_t c = 0; c < light->size(); ++c) {
+    const Transfer &l = (*light)[c], &b = one_back[c], &a = two_back[c];
+    last[0] += l.sun - b.sun, last[1] += l.clear - b.clear, last[2] += l.overcast - b.overcast;
+    previous[0] += b.sun - a.sun, previous[1] += b.clear - a.clear, previous[2] += b.overcast - a.overcast;
+  }
+  glm::vec3 gain[3];
+  for (int part = 0; part < 3; ++part) {
+    for (int ch = 0; ch < 3; ++ch) {
+      const double r = previous[part][ch] > 1e-12 ? std::clamp(last[part][ch] / previous[part][ch], 0.0, 0.9) : 0.0;
+      gain[part][ch] = static_cast<float>(r / (1.0 - r));
+    }
+  }
+  for (size_t c = 0; c < light->size(); ++c) {
+    Transfer& l = (*light)[c];
+    const Transfer& b = one_back[c];
+    l.sun += (l.sun - b.sun) * gain[0], l.clear += (l.clear - b.clear) * gain[1], l.overcast += (l.overcast - b.overcast) * gain[2];
+  }
 }
 
 void LightTransfer::DirectAndReflected(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct,

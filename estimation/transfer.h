@@ -55,6 +55,7 @@ struct TransferOptions {
   bool interreflection = true;  // the reflected terms
   int bounces = 4;              // the first exact at each ray's hit, the others through the cells;
                                 // 3 left a tenth of the red light under an arcade out (transfer_test)
+  bool close_series = true;     // the bounces past the last as a geometric series (SolveCells)
   bool sky_distribution = true; // the captured sky's (θ, γ) distribution; false: a uniform sky
 
   // Empty when every field is in range, else the first problem, naming the field.
@@ -74,6 +75,14 @@ struct TransferPoints {
 };
 
 // estimation::Transfer (lighting_model.h): irradiance per unit of each part of the light.
+
+// The light of the bounces a solve left out, added to `light` (its cells after the last pass,
+// `one_back` and `two_back` after the two before): each further bounce is taken to add a share r
+// of the one before, r the ratio of the last two passes' increments summed over all cells (per
+// part and channel; the dominant eigenvalue of the cells' transport, at most 0.9), so the tail is
+// Δ·r/(1 − r) for each cell's last increment Δ.
+void CloseGeometricSeries(const std::vector<Transfer>& two_back, const std::vector<Transfer>& one_back,
+                          std::vector<Transfer>* light);
 
 class LightTransfer {
  public:
