@@ -38,6 +38,8 @@ std::string FormatUtcTime(const UtcTime& utc, int decimals = 3);
 // The instant `seconds` after 1970-01-01T00:00:00Z (POSIX time: no leap seconds), and back.
 UtcTime UtcFromUnixSeconds(double seconds);
 double UnixSeconds(const UtcTime& utc);
+// `utc` moved by `seconds` (POSIX time: no leap seconds).
+inline UtcTime ShiftedUtc(const UtcTime& utc, double seconds) { return UtcFromUnixSeconds(UnixSeconds(utc) + seconds); }
 
 // Proleptic Gregorian calendar <-> days since 1970-01-01 (H. Hinnant's civil-day algorithms).
 int64_t DaysFromCivil(int year, int month, int day);

@@ -236,6 +236,25 @@ class PacedSource final : public FrameSource {
   double done_s_ = 0.0;       // of which the stretches before the current one
 };
 
+class ClockShiftedSource final : public FrameSource {
+ public:
+  ClockShiftedSource(std::unique_ptr<FrameSource> source, double seconds) : source_(std::move(source)), seconds_(seconds) {}
+
+  FrameStatus Next(Frame* frame) override {
+    const FrameStatus status = source_->Next(frame);
+    stats_ = source_->stats();
+    if (status == FrameStatus::kFrame || status == FrameStatus::kUndecodable) frame->utc = ShiftedUtc(frame->utc, seconds_);
+    return status;
+  }
+  void Seek(int index) override { source_->Seek(index); }
+  std::string Describe() const override { return fmt::format("{}, clock {:+.3f} s", source_->Describe(), seconds_); }
+  bool live() const override { return source_->live(); }
+
+ private:
+  std::unique_ptr<FrameSource> source_;
+  double seconds_;
+};
+
 }  // namespace
 
 std::filesystem::path FramePath(const std::string& pattern, int index) {
@@ -252,6 +271,10 @@ std::unique_ptr<FrameSource> OpenVideoSource(const std::filesystem::path& video,
 
 std::unique_ptr<FrameSource> OpenImageSequence(std::string pattern, FrameTimes times, double exposure) {
   return std::make_unique<ImageSequence>(std::move(pattern), std::move(times), exposure);
+}
+
+std::unique_ptr<FrameSource> ClockShifted(std::unique_ptr<FrameSource> source, double seconds) {
+  return std::make_unique<ClockShiftedSource>(std::move(source), seconds);
 }
 
 std::unique_ptr<FrameSource> Paced(std::unique_ptr<FrameSource> source, double speed) {

@@ -71,6 +71,10 @@ std::unique_ptr<FrameSource> OpenImageSequence(std::string pattern, FrameTimes t
 // The file of frame `index` for an image pattern.
 std::filesystem::path FramePath(const std::string& pattern, int index);
 
+// `source` with `seconds` added to every frame's time: a camera clock that is known to be off
+// (scene.json's frames.clock_offset_s: UTC = the clock's time + offset).
+std::unique_ptr<FrameSource> ClockShifted(std::unique_ptr<FrameSource> source, double seconds);
+
 // `source` paced to its timestamps: each frame is returned no earlier than its time after the
 // first frame's, divided by `speed`, on the steady clock (for replay in a window). A gap of more
 // than 2 s (after dividing by `speed`) between two frames, such as a time-lapse's bursts hours

@@ -167,6 +167,26 @@ TEST(FrameSourceTest, ImageSequenceReadsPngAndExrAndSkipsBrokenFiles) {
   EXPECT_EQ(exr->Next(&frame), FrameStatus::kEnd);
 }
 
+// A live camera's clock offset (scene.json's frames.clock_offset_s) is added to each frame's time,
+// decoded or not; pixels, indices and counts pass through.
+TEST(FrameSourceTest, AClockShiftedSourceMovesEveryFramesTime) {
+  FrameTimes times = Times();
+  times.frames.resize(3);
+  auto source = ClockShifted(OpenVideoSource(kRecording / "video.mp4", times, 1.0), -600.5);
+  Frame frame;
+  for (size_t i = 0; i < 3; ++i) {
+    ASSERT_EQ(source->Next(&frame), FrameStatus::kFrame);
+    EXPECT_EQ(frame.index, static_cast<int>(i));
+    EXPECT_NEAR(frame.utc.SecondsSince(times.frames[i].utc), -600.5, 1e-6);
+    EXPECT_FALSE(frame.rgb.empty());
+  }
+  EXPECT_EQ(source->Next(&frame), FrameStatus::kEnd);
+  EXPECT_EQ(source->stats().delivered, 3);
+  source->Seek(1);
+  ASSERT_EQ(source->Next(&frame), FrameStatus::kFrame);
+  EXPECT_EQ(frame.index, 1);
+}
+
 TEST(FrameSourceTest, PacedReplayKeepsToTheTimestamps) {
   // Frames 0.1 s apart, replayed at 4× speed: 5 frames take at least 0.1 s.
   FrameTimes times = Times();

@@ -41,6 +41,7 @@ struct FramesSpec {
   std::filesystem::path timestamps;  // kVideo, kImages
   std::string device;                // kDevice, e.g. /dev/video0
   double fps = 30.0;                 // kDevice
+  double clock_offset_s = 0.0;       // UTC = the frames' clock (frames.csv, a device's) + this
   capture::CameraSettings controls;  // kDevice: exposure, gain, white balance (absent: held from auto)
 
   // The image file of frame `index` (kImages only).

@@ -18,6 +18,7 @@ namespace fs = std::filesystem;
 
 // Tolerance on |RᵀR − I| for a rotation typed with ~9 significant digits.
 constexpr double kRotationTolerance = 1e-5;
+constexpr double kMaxClockOffsetS = 86400.0;  // frames.clock_offset_s: a clock a day off is not a drift
 
 bool allow_paths_outside = false;
 
@@ -219,8 +220,14 @@ bool IsFramePattern(const std::string& pattern) {
 
 void LoadFrames(const JsonField& root, Scene* scene) {
   const JsonField frames = root.Get("frames");
-  frames.WarnUnknownKeys({"video", "images", "timestamps", "device", "fps", "controls"});
+  frames.WarnUnknownKeys({"video", "images", "timestamps", "device", "fps", "controls", "clock_offset_s"});
   FramesSpec& spec = scene->frames;
+  if (auto offset = frames.Find("clock_offset_s")) {
+    spec.clock_offset_s = offset->Number();
+    if (!(std::abs(spec.clock_offset_s) <= kMaxClockOffsetS)) {
+      offset->Fail(fmt::format("{} is outside [-{}, {}] (a day)", spec.clock_offset_s, kMaxClockOffsetS, kMaxClockOffsetS));
+    }
+  }
   const int kinds = frames.Has("video") + frames.Has("images") + frames.Has("device");
   if (kinds != 1) frames.Fail("give exactly one of \"video\", \"images\" or \"device\"");
   if (auto device = frames.Find("device")) {
@@ -261,6 +268,9 @@ void LoadFrames(const JsonField& root, Scene* scene) {
   }
   spec.timestamps = RequireFile(*scene, frames.Get("timestamps"));
   scene->frame_times = capture::LoadFrameTimes(spec.timestamps);
+  if (spec.clock_offset_s != 0.0) {
+    for (capture::FrameTime& f : scene->frame_times->frames) f.utc = ShiftedUtc(f.utc, spec.clock_offset_s);
+  }
 }
 
 void LoadObjects(const JsonField& root, Scene* scene) {
@@ -397,7 +407,9 @@ std::unique_ptr<capture::FrameSource> OpenFrameSource(const Scene& scene) {
   options.settings = scene.frames.controls;
   options.exposure = scene.exposure;
   options.newest_only = true;  // estimate and live run on what the camera sees now
-  return capture::OpenV4l2Source(scene.frames.device, options);
+  std::unique_ptr<capture::FrameSource> source = capture::OpenV4l2Source(scene.frames.device, options);
+  if (scene.frames.clock_offset_s == 0.0) return source;
+  return capture::ClockShifted(std::move(source), scene.frames.clock_offset_s);
 }
 
 SceneSun SunAt(const Scene& scene, const UtcTime& utc) {

@@ -120,6 +120,37 @@ TEST(SceneLoaderTest, ImageSequenceAndLiveDeviceSources) {
   EXPECT_FALSE(live.frame_times.has_value());
 }
 
+// frames.clock_offset_s moves every frame's time (UTC = frames.csv + offset), so the sun of frame N
+// is the ephemeris's at the corrected time; absent, nothing moves; beyond a day, refused by name.
+TEST(SceneLoaderTest, AClockOffsetMovesEveryFramesTime) {
+  SceneSandbox sandbox("clock");
+  std::filesystem::create_directories(sandbox.dir() / "frames");
+  sandbox.WriteText("frames/000000.png", "");
+  sandbox.WriteText("times.csv", "frame,time_utc\n0,2026-06-21T05:00:00Z\n1,2026-06-21T23:59:59.5Z\n");
+  sandbox.json()["frames"] = {{"images", "frames/%06d.png"}, {"timestamps", "times.csv"}};
+  const Scene plain = LoadScene(sandbox.Write());
+  EXPECT_EQ(plain.frames.clock_offset_s, 0.0);
+  EXPECT_EQ(FormatUtcTime(plain.frame_times->frames[0].utc), "2026-06-21T05:00:00.000Z");
+
+  sandbox.json()["frames"]["clock_offset_s"] = -90.25;
+  const Scene early = LoadScene(sandbox.Write());
+  EXPECT_EQ(FormatUtcTime(early.frame_times->frames[0].utc), "2026-06-21T04:58:29.750Z");
+  sandbox.json()["frames"]["clock_offset_s"] = 0.75;
+  const Scene late = LoadScene(sandbox.Write());
+  EXPECT_EQ(FormatUtcTime(late.frame_times->frames[1].utc), "2026-06-22T00:00:00.250Z");  // over midnight
+  EXPECT_EQ(FormatUtcTime(late.frame_times->frames[0].utc), "2026-06-21T05:00:00.750Z");
+
+  for (double bad : {86400.5, -1e9}) {
+    sandbox.json()["frames"]["clock_offset_s"] = bad;
+    try {
+      LoadScene(sandbox.Write());
+      ADD_FAILURE() << bad << " was taken";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("frames.clock_offset_s"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(SceneLoaderTest, ACalibratedResponseCurveIsReadFromItsFile) {
   SceneSandbox sandbox("curve");
   std::string csv = "code,r,g,b\n";
