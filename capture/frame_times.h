@@ -9,6 +9,10 @@
 
 namespace daylit::capture {
 
+// A recording may come in bursts (a time-lapse of short clips): frames this far apart or more
+// start a new one. The estimate's per-burst table and the shadow calibration split alike.
+constexpr double kBurstGapS = 2.0;
+
 struct FrameTime {
   int index = 0;
   UtcTime utc;

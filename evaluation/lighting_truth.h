@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "capture/frame_times.h"
 #include "estimation/frame_estimator.h"
 #include "evaluation/run_report.h"
 #include "scene/scene.h"
@@ -50,7 +51,7 @@ struct Burst {
   int index = 0;
   size_t begin = 0, end = 0;
 };
-constexpr double kBurstGapS = 2.0;
+constexpr double kBurstGapS = capture::kBurstGapS;
 std::vector<Burst> SplitBursts(const std::vector<estimation::FrameEstimate>& frames, double gap_s = kBurstGapS);
 
 // One burst's estimates and, with truth, their errors: medians over its frames of

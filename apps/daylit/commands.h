@@ -19,6 +19,7 @@ void AddEstimateCommand(CLI::App& app);
 void AddRelightEnvCommand(CLI::App& app);
 void AddLightsCommand(CLI::App& app);
 void AddCalibrateCommands(CLI::App& app);
+void AddCalibrateSceneCommand(CLI::App& app);
 void AddRecordCommand(CLI::App& app);
 void AddRenderCommand(CLI::App& app);
 void AddReplayCommand(CLI::App& app);

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "apps/daylit/commands.h"
+#include "apps/daylit/shadow_check.h"
 #include "bake/bake.h"
 #include "base/error.h"
 #include "base/log.h"
@@ -55,6 +56,9 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   pipeline::LightingPipeline lighting(scene, baked, caster, options);
   std::optional<evaluation::ResidualSink> residuals;
   if (!o.residuals.empty()) lighting.AddSink(&residuals.emplace(scene, baked, o.residual));
+  // A recording's shadows are checked against the model's (north and clock); a live run is not.
+  std::optional<ShadowCheckSink> shadows;
+  if (scene.frame_times) lighting.AddSink(&shadows.emplace(scene, baked));
   const pipeline::PipelineRun run = lighting.Run(std::move(source));
   const size_t n = run.frames.size();
   double moves_ms = 0.0;
@@ -63,6 +67,7 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   evaluation::RunFigures(run, &report);
   evaluation::ReportLighting(scene, run.frames, o.out, plot, &report);
   if (residuals) residuals->Finish(o.residuals, &report);
+  if (shadows) CheckShadowsAndSay(scene, baked, caster, shadows->Finish(), &report);
   if (!o.figures.empty()) report.WriteFigures(o.figures);
   Log().info("{} frames in {:.2f} s ({:.0f} fps end to end); estimation after decoding {:.2f} ms per frame (median), "
              "plus {} sun moves taking {:.0f} ms in all; wrote {} and {}",

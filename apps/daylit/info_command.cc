@@ -4,6 +4,10 @@
 #include <fmt/format.h>
 
 #include "apps/daylit/commands.h"
+#include "apps/daylit/shadow_check.h"
+#include "bake/bake.h"
+#include "calibrate/shadow_calibration.h"
+#include "scene/raycaster.h"
 #include "base/csv.h"
 #include "base/error.h"
 #include "base/log.h"
@@ -85,7 +89,11 @@ std::vector<std::string> PrintFrames(const scene::Scene& scene) {
   const scene::FramesSpec& f = scene.frames;
   if (f.kind == scene::FrameSourceKind::kDevice) {
     fmt::print("frames       live camera {} at {} fps\n", f.device, f.fps);
+    if (f.clock_offset_s != 0.0) fmt::print("             its clock {:+.1f} s from UTC (frames.clock_offset_s)\n", -f.clock_offset_s);
     return problems;
+  }
+  if (f.clock_offset_s != 0.0) {
+    fmt::print("clock        frames.csv's times {:+.1f} s (frames.clock_offset_s): the times below are UTC\n", f.clock_offset_s);
   }
   const capture::FrameTimes& times = *scene.frame_times;
   const size_t n = times.frames.size();
@@ -186,7 +194,32 @@ void PrintGroundTruth(const scene::Scene& scene, std::vector<std::string>* missi
   }
 }
 
-void RunInfo(const std::string& recording) {
+// The frames' shadows against the model's, where the cache holds a current bake (the check needs
+// its G-buffer and albedo); said as a line, a disagreement also as a problem.
+void PrintShadowCheck(const scene::Scene& scene, const std::string& cache, std::vector<std::string>* problems) {
+  if (!scene.frame_times) return;
+  const fs::path dir = bake::CacheDir(scene, cache);
+  const std::optional<bake::SceneBake> baked = bake::LoadBake(dir, bake::BakeHash(scene, bake::BakeOptions{}));
+  if (!baked) {
+    fmt::print("shadows      not checked: no current bake in {} (daylit bake makes one)\n", dir.string());
+    return;
+  }
+  const scene::RayCaster caster(scene.model);
+  const calibrate::ShadowObservations observed = calibrate::ObserveShadows(scene, *baked, caster);
+  const std::optional<calibrate::ShadowCheck> check = CheckShadowsAndSay(scene, *baked, caster, observed, nullptr);
+  if (!check) {
+    fmt::print("shadows      not checked: no burst shows the sun clearly on the model\n");
+  } else if (std::abs(check->north_offset_deg) > kShadowCheckNorthDeg) {
+    fmt::print("shadows      off: where the model's would fall with north {:+.2f} deg off; run daylit calibrate-scene\n",
+               check->north_offset_deg);
+    problems->push_back(fmt::format("the frames' shadows disagree with the model's by {:+.2f} deg of north", check->north_offset_deg));
+  } else {
+    fmt::print("shadows      agree with the model's: the best north is {:+.2f} deg from the scene's ({} bursts)\n",
+               check->north_offset_deg, observed.bursts.size());
+  }
+}
+
+void RunInfo(const std::string& recording, const std::string& cache, bool check_shadows) {
   const scene::Scene scene = scene::LoadScene(recording);
   fmt::print("recording    {} ({}, {})\n", scene.name, scene.file.string(), scene::kRecordingFormat);
   fmt::print("location     {:.6f} N, {:.6f} E, {:.1f} m; scene +Y at compass {:.2f} deg\n",
@@ -196,7 +229,8 @@ void RunInfo(const std::string& recording) {
   PrintCamera(scene);
   std::vector<std::string> missing;
   PrintEnvMap(scene, &missing);
-  const std::vector<std::string> problems = PrintFrames(scene);
+  std::vector<std::string> problems = PrintFrames(scene);
+  if (check_shadows) PrintShadowCheck(scene, cache, &problems);
   PrintObjectsAndVolume(scene, &missing);
   PrintGroundTruth(scene, &missing);
   fmt::print("missing      {}\n", missing.empty() ? std::string("nothing") : fmt::format("{}", fmt::join(missing, "; ")));
@@ -207,10 +241,18 @@ void RunInfo(const std::string& recording) {
 }  // namespace
 
 void AddInfoCommand(CLI::App& app) {
-  auto recording = std::make_shared<std::string>();
+  struct Options {
+    std::string recording, cache;
+    bool no_shadows = false;
+  };
+  auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("info", "Validate a recording and summarise it (frames, time span, sun path, surfaces)");
-  cmd->add_option("recording", *recording, "Recording folder or its scene.json")->required();
-  cmd->callback([recording] { RunInfo(*recording); });
+  cmd->footer("Where the cache holds a current bake, the frames' shadows are checked against the model's (north and\n"
+              "clock): a disagreement beyond 0.5 deg of north is a warning that suggests daylit calibrate-scene.");
+  cmd->add_option("recording", o->recording, "Recording folder or its scene.json")->required();
+  cmd->add_option("--cache", o->cache, "Bake cache folder (as for daylit bake)");
+  cmd->add_flag("--no-shadow-check", o->no_shadows, "Skip the shadow check (it reads every frame)");
+  cmd->callback([o] { RunInfo(o->recording, o->cache, !o->no_shadows); });
 }
 
 }  // namespace daylit::app

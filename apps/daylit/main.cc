@@ -38,6 +38,7 @@ int main(int argc, char** argv) {
   daylit::app::AddRelightEnvCommand(app);
   daylit::app::AddLightsCommand(app);
   daylit::app::AddCalibrateCommands(app);
+  daylit::app::AddCalibrateSceneCommand(app);
   daylit::app::AddRecordCommand(app);
   daylit::app::AddRenderCommand(app);
   daylit::app::AddReplayCommand(app);

@@ -1,0 +1,38 @@
+// The quick shadow check of `daylit info` and `daylit estimate`: do the frames' shadows fall where
+// the model's do? A north (or clock) that is off moves them apart; beyond the equivalent of 0.5°
+// of north this warns and suggests `daylit calibrate-scene`.
+#pragma once
+
+#include <optional>
+
+#include "bake/bake.h"
+#include "calibrate/shadow_calibration.h"
+#include "evaluation/run_report.h"
+#include "pipeline/lighting_pipeline.h"
+#include "scene/raycaster.h"
+#include "scene/scene.h"
+
+namespace daylit::app {
+
+inline constexpr double kShadowCheckNorthDeg = 0.5;
+
+// Feeds the pipeline's frames to a ShadowObserver.
+class ShadowCheckSink final : public pipeline::FrameSink {
+ public:
+  ShadowCheckSink(const scene::Scene& scene, const bake::SceneBake& bake) : observer_(scene, bake) {}
+  void Consume(const pipeline::PipelineFrame& frame) override;
+  calibrate::ShadowObservations Finish() { return observer_.Finish(); }
+
+ private:
+  calibrate::ShadowObserver observer_;
+};
+
+// Runs the check on what was observed: warns (stderr) when the model's shadows sit where a north
+// more than kShadowCheckNorthDeg off would put them; says on stderr when the footage cannot tell
+// (no clear burst). Adds shadow_check/* figures to `report` when given. Returns the check.
+std::optional<calibrate::ShadowCheck> CheckShadowsAndSay(const scene::Scene& scene, const bake::SceneBake& bake,
+                                                         const scene::RayCaster& caster,
+                                                         const calibrate::ShadowObservations& observed,
+                                                         evaluation::RunReport* report);
+
+}  // namespace daylit::app

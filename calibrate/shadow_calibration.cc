@@ -1,0 +1,510 @@
+#include "calibrate/shadow_calibration.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <utility>
+
+#include <glm/gtc/constants.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "base/error.h"
+#include "base/log.h"
+#include "base/progress.h"
+#include "capture/frame_source.h"
+#include "capture/read_ahead.h"
+#include "estimation/frame_estimator.h"
+#include "scene/sun_tracker.h"
+#include "sunmodel/geo_frame.h"
+#include "sunmodel/solar_position.h"
+
+namespace daylit::calibrate {
+namespace {
+
+constexpr float kNoSigma = std::numeric_limits<float>::quiet_NaN();
+constexpr float kRayOffsetM = 2e-3f;  // shadow rays start this far off the surface (as the transfer's)
+constexpr int kMinClearFrames = 3;     // a burst with fewer gives no σ
+constexpr size_t kMinSunlitPixels = 200;  // nor one whose σ shows less sun than this
+
+// How sunlit each diffuse pixel looks in `radiance` (interleaved RGB, radiance units) under the
+// frame's light: the irradiance π·L/ρ less the sky's share E_sky·V, over the sun's E_sun·cos.
+void SunlitFraction(const bake::CameraGBuffer& g, const std::vector<uint32_t>& diffuse, const std::vector<float>& radiance,
+                    double exposure, const estimation::SunSky& light, const glm::vec3& sun_dir, std::vector<float>* sigma) {
+  sigma->resize(diffuse.size());
+  const glm::vec3 e_sun(light.sun_rgb), e_sky(light.sky_rgb);
+  const float sun_sum = e_sun.x + e_sun.y + e_sun.z;
+  const float saturated = static_cast<float>(0.98 / exposure);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, diffuse.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const uint32_t p = diffuse[i];
+      const float c = glm::dot(g.normal[p], sun_dir);
+      const glm::vec3 rho = g.albedo[p];
+      const glm::vec3 l(radiance[3 * p], radiance[3 * p + 1], radiance[3 * p + 2]);
+      if (c < 0.05f || rho.x < 0.02f || rho.y < 0.02f || rho.z < 0.02f || l.x >= saturated || l.y >= saturated ||
+          l.z >= saturated) {
+        (*sigma)[i] = kNoSigma;
+        continue;
+      }
+      const glm::vec3 beyond_sky = glm::pi<float>() * l / rho - e_sky * g.sky_visibility[p];
+      (*sigma)[i] = (beyond_sky.x + beyond_sky.y + beyond_sky.z) / (sun_sum * c);
+    }
+  });
+}
+
+// The burst's σ: the median over its clear frames, per pixel, where at least half of them saw it.
+BurstShadows MedianShadows(const bake::CameraGBuffer& g, const std::vector<uint32_t>& diffuse,
+                           const std::vector<const std::vector<float>*>& frames, const UtcTime& time, const scene::Scene& scene,
+                           double min_cos) {
+  BurstShadows burst;
+  burst.frames = static_cast<int>(frames.size());
+  burst.time = time;
+  const glm::vec3 sun = SunWith(scene, burst.time, 0.0, 0.0);
+  std::vector<float> values;
+  for (size_t i = 0; i < diffuse.size(); ++i) {
+    if (glm::dot(g.normal[diffuse[i]], sun) < static_cast<float>(min_cos)) continue;
+    values.clear();
+    for (const std::vector<float>* f : frames) {
+      if (!std::isnan((*f)[i])) values.push_back((*f)[i]);
+    }
+    if (2 * values.size() < frames.size() || values.empty()) continue;
+    const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), mid, values.end());
+    burst.pixels.push_back(diffuse[i]);
+    burst.sunlit.push_back(std::clamp(*mid, 0.0f, 1.0f));
+  }
+  return burst;
+}
+
+// A burst's rays: origins off the surface and normals, in the order of its pixels.
+struct BurstRays {
+  std::vector<glm::vec3> origin, normal;
+};
+
+// The search's state: every burst's rays and σ, and the sun of each burst for given offsets.
+class ShadowScore {
+ public:
+  ShadowScore(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+              const ShadowObservations& observed)
+      : scene_(scene), caster_(caster), observed_(observed) {
+    for (const BurstShadows& b : observed.bursts) {
+      BurstRays r;
+      for (uint32_t p : b.pixels) {
+        r.normal.push_back(bake.camera.normal[p]);
+        r.origin.push_back(bake.camera.point[p] + kRayOffsetM * bake.camera.normal[p]);
+      }
+      rays_.push_back(std::move(r));
+    }
+  }
+
+  size_t bursts() const { return rays_.size(); }
+  size_t pixels(size_t b) const { return rays_[b].origin.size(); }
+
+  // V (1: the sun reaches it) of the listed pixels of burst `b` for the offsets.
+  void Visibility(size_t b, const std::vector<uint32_t>& which, double north, double clock, std::vector<uint8_t>* v) const {
+    const glm::vec3 sun = SunWith(scene_, observed_.bursts[b].time, north, clock);
+    v->assign(which.size(), 0);
+    if (sun.z <= 0.0f) return;
+    const BurstRays& r = rays_[b];
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, which.size(), 2048), [&](const tbb::blocked_range<size_t>& range) {
+      thread_local std::vector<glm::vec3> origins;
+      thread_local std::vector<uint8_t> occluded;
+      origins.clear();
+      for (size_t i = range.begin(); i != range.end(); ++i) origins.push_back(r.origin[which[i]]);
+      occluded.resize(origins.size());
+      caster_.OccludedAlong(origins.data(), origins.size(), sun, 0.0f, occluded.data());
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        (*v)[i] = !occluded[i - range.begin()] && glm::dot(r.normal[which[i]], sun) > 0.0f;
+      }
+    });
+  }
+
+  // Σ |σ − V| over the listed pixels of each burst (`which[b]`), per burst.
+  std::vector<double> PerBurst(const std::vector<std::vector<uint32_t>>& which, double north, double clock) const {
+    std::vector<double> score(bursts(), 0.0);
+    std::vector<uint8_t> v;
+    for (size_t b = 0; b < bursts(); ++b) {
+      if (which[b].empty()) continue;
+      Visibility(b, which[b], north, clock, &v);
+      const std::vector<float>& sigma = observed_.bursts[b].sunlit;
+      double s = 0.0;
+      for (size_t i = 0; i < which[b].size(); ++i) s += std::abs(sigma[which[b][i]] - static_cast<float>(v[i]));
+      score[b] = s;
+    }
+    return score;
+  }
+
+  // The share of the listed pixels on the wrong side (|σ − V| > 0.5).
+  double Disagree(const std::vector<std::vector<uint32_t>>& which, double north, double clock) const {
+    size_t wrong = 0, all = 0;
+    std::vector<uint8_t> v;
+    for (size_t b = 0; b < bursts(); ++b) {
+      if (which[b].empty()) continue;
+      Visibility(b, which[b], north, clock, &v);
+      const std::vector<float>& sigma = observed_.bursts[b].sunlit;
+      for (size_t i = 0; i < which[b].size(); ++i) wrong += std::abs(sigma[which[b][i]] - static_cast<float>(v[i])) > 0.5f;
+      all += which[b].size();
+    }
+    return all == 0 ? 0.0 : static_cast<double>(wrong) / static_cast<double>(all);
+  }
+
+ private:
+  const scene::Scene& scene_;
+  const scene::RayCaster& caster_;
+  const ShadowObservations& observed_;
+  std::vector<BurstRays> rays_;
+};
+
+struct Offsets {
+  double north = 0.0, clock = 0.0;
+};
+
+double Sum(const std::vector<double>& v, int leave_out = -1) {
+  double s = 0.0;
+  for (size_t i = 0; i < v.size(); ++i) s += static_cast<int>(i) == leave_out ? 0.0 : v[i];
+  return s;
+}
+
+// Halving pattern search from `start`: at each step the best of the 3×3 neighbourhood (only the
+// fitted axes) until the centre is best, then half the step, until below the tolerances.
+Offsets PatternSearch(const ShadowScore& score, const std::vector<std::vector<uint32_t>>& which, Offsets start,
+                      double north_step, double clock_step, const FitOptions& options, int leave_out,
+                      const Offsets& low, const Offsets& high) {
+  const auto total = [&](const Offsets& o) { return Sum(score.PerBurst(which, o.north, o.clock), leave_out); };
+  Offsets best = start;
+  double best_score = total(best);
+  while ((options.north && north_step >= options.north_tolerance_deg) || (options.clock && clock_step >= options.clock_tolerance_s)) {
+    for (int move = 0; move < 6; ++move) {
+      Offsets centre = best;
+      for (int i = options.north ? -1 : 0; i <= (options.north ? 1 : 0); ++i) {
+        for (int j = options.clock ? -1 : 0; j <= (options.clock ? 1 : 0); ++j) {
+          if (i == 0 && j == 0) continue;
+          const Offsets o{std::clamp(centre.north + i * north_step, low.north, high.north),
+                          std::clamp(centre.clock + j * clock_step, low.clock, high.clock)};
+          const double s = total(o);
+          if (s < best_score) best_score = s, best = o;
+        }
+      }
+      if (best.north == centre.north && best.clock == centre.clock) break;
+    }
+    north_step *= 0.5, clock_step *= 0.5;
+  }
+  return best;
+}
+
+}  // namespace
+
+glm::vec3 SunWith(const scene::Scene& scene, const UtcTime& utc, double north_offset_deg, double clock_offset_s) {
+  const sunmodel::SunPosition sun = sunmodel::ComputeSunPosition(
+      ShiftedUtc(utc, clock_offset_s), scene.location, sunmodel::Atmosphere::Standard(scene.location.elevation_m), {});
+  const sunmodel::SceneGeoFrame geo(scene.location, scene.north_azimuth_deg + north_offset_deg);
+  return glm::vec3(geo.DirectionInScene(sun.azimuth_deg, sun.apparent_zenith_deg));
+}
+
+ShadowObserver::ShadowObserver(const scene::Scene& scene, const bake::SceneBake& bake, const ObserveOptions& options)
+    : scene_(scene), bake_(bake), options_(options), linearizer_(scene.response) {
+  const bake::CameraGBuffer& g = bake.camera;
+  for (uint32_t p = 0; p < g.surface.size(); ++p) {
+    if (g.diffuse[p] && g.surface[p] != bake::kNoSurface) diffuse_.push_back(p);
+  }
+}
+
+void ShadowObserver::Step(const capture::Frame& frame) {
+  const bool gap = previous_ && !(frame.utc.SecondsSince(*previous_) < capture::kBurstGapS);
+  if (gap) CloseBurst();
+  if (!previous_ || gap) first_ = frame.index;
+  previous_ = frame.utc, last_ = frame.index;
+}
+
+void ShadowObserver::AddUnreadable(const capture::Frame& frame) { Step(frame); }
+
+void ShadowObserver::Add(const capture::Frame& frame, const estimation::FrameEstimate& row) {
+  Step(frame);
+  ++out_.frames_read;
+  if (!row.sun_up || !row.HasEstimate() || row.sunlit_samples < 30) return;
+  const glm::dvec3& e_sun = row.light.sun_rgb;
+  const glm::dvec3& e_sky = row.light.sky_rgb;
+  const double ratio = (e_sun.x + e_sun.y + e_sun.z) / (e_sky.x + e_sky.y + e_sky.z);
+  if (!(ratio >= options_.min_sun_to_sky)) return;
+  auto weakest = std::min_element(kept_.begin(), kept_.end(),
+                                  [](const ClearFrame& a, const ClearFrame& b) { return a.sun_to_sky < b.sun_to_sky; });
+  const bool full = static_cast<int>(kept_.size()) >= options_.frames_per_burst;
+  if (full && weakest->sun_to_sky >= ratio) return;
+  ClearFrame f{ratio, frame.utc, frame.index, {}};
+  capture::LinearRadiance(frame, linearizer_, &radiance_);
+  SunlitFraction(bake_.camera, diffuse_, radiance_, frame.exposure, row.light, SunWith(scene_, frame.utc, 0.0, 0.0), &f.sigma);
+  if (full) {
+    *weakest = std::move(f);
+  } else {
+    kept_.push_back(std::move(f));
+  }
+}
+
+void ShadowObserver::CloseBurst() {
+  if (static_cast<int>(kept_.size()) >= kMinClearFrames) {
+    std::sort(kept_.begin(), kept_.end(), [](const ClearFrame& a, const ClearFrame& b) { return a.index < b.index; });
+    std::vector<const std::vector<float>*> sigma;
+    for (const ClearFrame& f : kept_) sigma.push_back(&f.sigma);
+    BurstShadows b = MedianShadows(bake_.camera, diffuse_, sigma, kept_[kept_.size() / 2].utc, scene_, options_.min_cos);
+    b.burst = out_.bursts_seen, b.first_frame = first_, b.last_frame = last_;
+    const size_t sunlit = static_cast<size_t>(std::count_if(b.sunlit.begin(), b.sunlit.end(), [](float s) { return s > 0.5f; }));
+    if (sunlit >= kMinSunlitPixels) {
+      out_.bursts.push_back(std::move(b));
+    } else {
+      Log().info("burst {} (frames {}-{}): {} pixels of the model look sunlit; left out", out_.bursts_seen, first_, last_, sunlit);
+    }
+  }
+  kept_.clear();
+  ++out_.bursts_seen;
+}
+
+ShadowObservations ShadowObserver::Finish() {
+  if (previous_) CloseBurst();
+  previous_.reset();
+  return std::move(out_);
+}
+
+ShadowObservations ObserveShadows(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                                  const ObserveOptions& options) {
+  if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
+  std::unique_ptr<capture::FrameSource> frames = capture::ReadAhead(scene::OpenFrameSource(scene), 4);
+  scene::SunTracker tracker(scene);
+  estimation::FrameEstimator estimator(scene, bake, caster, {});
+  ShadowObserver observer(scene, bake, options);
+  size_t total = scene.frame_times->frames.size();
+  if (options.max_frames > 0) total = std::min(total, static_cast<size_t>(options.max_frames));
+  Progress progress("shadows", total);
+  for (size_t i = 0; i < total; ++i) {
+    capture::Frame frame;
+    const capture::FrameStatus status = frames->Next(&frame);
+    if (status == capture::FrameStatus::kEnd) break;
+    progress.Advance();
+    const scene::TrackedSun& sun = tracker.Update(frame.utc);
+    if (status != capture::FrameStatus::kFrame || frame.rgb.cols != bake.camera.width || frame.rgb.rows != bake.camera.height) {
+      observer.AddUnreadable(frame);
+      continue;
+    }
+    observer.Add(frame, estimator.Estimate(frame, sun).row);
+  }
+  ShadowObservations out = observer.Finish();
+  if (out.frames_read == 0) ThrowInputError("{}: no frame of the recording could be read", scene.file.string());
+  return out;
+}
+
+FitResult FitNorthAndClock(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                           const ShadowObservations& observed, const FitOptions& requested) {
+  if (observed.bursts.empty()) {
+    ThrowInputError("{}: no burst of the {} shows the sun on the model's diffuse surfaces (overcast, or the sun on none "
+                    "of them): the footage cannot constrain north or the clock",
+                    scene.file.string(), observed.bursts_seen == 1 ? "one burst" : fmt::format("{} bursts", observed.bursts_seen));
+  }
+  FitOptions options = requested;
+  FitResult result;
+  double earliest = 0.0, latest = 0.0;
+  for (const BurstShadows& b : observed.bursts) {
+    const double t = b.time.SecondsSince(observed.bursts.front().time);
+    earliest = std::min(earliest, t), latest = std::max(latest, t);
+    result.frames += b.frames;
+    result.pixels += b.pixels.size();
+  }
+  result.bursts = static_cast<int>(observed.bursts.size());
+  if (options.north && options.clock && latest - earliest < options.min_span_for_both_s) {
+    options.clock = false;
+    result.note = fmt::format(
+        "the bursts with sun span {:.0f} min, one time of day: a north offset and a clock offset move the sun alike "
+        "(along its path), so only north was fitted and the clock held; bursts {:.0f} min or more apart give both",
+        (latest - earliest) / 60.0, options.min_span_for_both_s / 60.0);
+  }
+  if (!options.north && !options.clock) ThrowInputError("calibrate: nothing to fit (give north or clock)");
+  result.north_fitted = options.north, result.clock_fitted = options.clock;
+  const ShadowScore score(scene, bake, caster, observed);
+  const size_t bursts = score.bursts();
+
+  // The coarse grid over every n-th pixel.
+  std::vector<std::vector<uint32_t>> coarse(bursts), all(bursts);
+  for (size_t b = 0; b < bursts; ++b) {
+    for (uint32_t i = 0; i < score.pixels(b); ++i) {
+      all[b].push_back(i);
+      if (i % static_cast<uint32_t>(std::max(1, options.coarse_stride)) == 0) coarse[b].push_back(i);
+    }
+  }
+  const int north_steps = options.north ? static_cast<int>(std::round(options.north_range_deg / options.north_step_deg)) : 0;
+  const int clock_steps = options.clock ? static_cast<int>(std::round(options.clock_range_s / options.clock_step_s)) : 0;
+  const Offsets low{-north_steps * options.north_step_deg, -clock_steps * options.clock_step_s};
+  const Offsets high{north_steps * options.north_step_deg, clock_steps * options.clock_step_s};
+  // Which coarse pixels change sides anywhere on the grid: the edges (the rest add the same to
+  // every candidate).
+  std::vector<std::vector<uint8_t>> seen(bursts);
+  std::vector<std::vector<uint8_t>> first_v(bursts);
+  Offsets best;
+  double best_score = std::numeric_limits<double>::infinity();
+  std::vector<uint8_t> v;
+  Progress progress("search", static_cast<size_t>((2 * north_steps + 1) * (2 * clock_steps + 1)));
+  for (int i = -north_steps; i <= north_steps; ++i) {
+    for (int j = -clock_steps; j <= clock_steps; ++j) {
+      const Offsets o{i * options.north_step_deg, j * options.clock_step_s};
+      double s = 0.0;
+      for (size_t b = 0; b < bursts; ++b) {
+        score.Visibility(b, coarse[b], o.north, o.clock, &v);
+        if (first_v[b].empty()) first_v[b] = v, seen[b].assign(v.size(), 0);
+        const std::vector<float>& sigma = observed.bursts[b].sunlit;
+        for (size_t k = 0; k < v.size(); ++k) {
+          s += std::abs(sigma[coarse[b][k]] - static_cast<float>(v[k]));
+          seen[b][k] |= v[k] != first_v[b][k];
+        }
+      }
+      if (s < best_score) best_score = s, best = o;
+      progress.Advance();
+    }
+  }
+  std::vector<std::vector<uint32_t>> edges(bursts);
+  for (size_t b = 0; b < bursts; ++b) {
+    for (size_t k = 0; k < coarse[b].size(); ++k) {
+      if (seen[b][k]) edges[b].push_back(coarse[b][k]);
+    }
+    result.edge_pixels += edges[b].size();
+  }
+  result.at_range_edge = (options.north && std::abs(best.north) >= high.north - 1e-9) ||
+                         (options.clock && std::abs(best.clock) >= high.clock - 1e-9);
+
+  // The fine search over every pixel near the coarse best's edges: those whose side changes
+  // within two coarse steps of it.
+  std::vector<std::vector<uint32_t>> band(bursts);
+  for (size_t b = 0; b < bursts; ++b) {
+    std::vector<uint8_t> changes(all[b].size(), 0), base;
+    score.Visibility(b, all[b], best.north, best.clock, &base);
+    for (int i = options.north ? -2 : 0; i <= (options.north ? 2 : 0); ++i) {
+      for (int j = options.clock ? -2 : 0; j <= (options.clock ? 2 : 0); ++j) {
+        if (i == 0 && j == 0) continue;
+        score.Visibility(b, all[b], best.north + i * options.north_step_deg, best.clock + j * options.clock_step_s, &v);
+        for (size_t k = 0; k < v.size(); ++k) changes[k] |= v[k] != base[k];
+      }
+    }
+    for (size_t k = 0; k < all[b].size(); ++k) {
+      if (changes[k]) band[b].push_back(all[b][k]);
+    }
+  }
+  const Offsets fine = PatternSearch(score, band, best, 0.5 * options.north_step_deg, 0.5 * options.clock_step_s, options, -1,
+                                     low, high);
+  result.north_offset_deg = fine.north, result.clock_offset_s = fine.clock;
+  result.disagree_before = score.Disagree(edges, 0.0, 0.0);
+  result.disagree_after = score.Disagree(edges, fine.north, fine.clock);
+
+  // The uncertainty: the jackknife over bursts (each left out in turn, searched again from the
+  // fit), or with fewer than three, where the score rises by its own noise (√ of the edge count).
+  if (bursts >= 3) {
+    std::vector<Offsets> leave(bursts);
+    for (size_t b = 0; b < bursts; ++b) {
+      leave[b] = PatternSearch(score, band, fine, 0.25 * options.north_step_deg, 0.25 * options.clock_step_s, options,
+                               static_cast<int>(b), low, high);
+    }
+    const double n = static_cast<double>(bursts);
+    Offsets mean;
+    for (const Offsets& o : leave) mean.north += o.north / n, mean.clock += o.clock / n;
+    double vn = 0.0, vc = 0.0;
+    for (const Offsets& o : leave) vn += (o.north - mean.north) * (o.north - mean.north), vc += (o.clock - mean.clock) * (o.clock - mean.clock);
+    result.north_sigma_deg = std::sqrt((n - 1.0) / n * vn), result.clock_sigma_s = std::sqrt((n - 1.0) / n * vc);
+  } else {
+    const double at_best = Sum(score.PerBurst(band, fine.north, fine.clock));
+    size_t band_pixels = 0;
+    for (const auto& b : band) band_pixels += b.size();
+    const double rise = std::max(1.0, std::sqrt(static_cast<double>(band_pixels)));
+    const auto width = [&](bool north_axis, double step, double limit) {
+      double w = 0.0;
+      for (int side : {-1, 1}) {
+        double d = step;
+        while (d < limit) {
+          const Offsets o{fine.north + (north_axis ? side * d : 0.0), fine.clock + (north_axis ? 0.0 : side * d)};
+          if (Sum(score.PerBurst(band, o.north, o.clock)) > at_best + rise) break;
+          d += step;
+        }
+        w += 0.5 * d;
+      }
+      return w;
+    };
+    if (options.north) result.north_sigma_deg = width(true, options.north_tolerance_deg * 2.0, 2.0 * options.north_step_deg);
+    if (options.clock) result.clock_sigma_s = width(false, options.clock_tolerance_s * 2.0, 2.0 * options.clock_step_s);
+  }
+  return result;
+}
+
+std::vector<uint8_t> CaptureEdgeMask(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                                     double north_offset_deg) {
+  const bake::CameraGBuffer& g = bake.camera;
+  std::vector<uint8_t> mask(g.surface.size(), 0);
+  if (!scene.envmap) return mask;
+  std::vector<uint32_t> seen;  // pixels whose albedo is the env map's own texel's
+  std::vector<glm::vec3> origins;
+  for (uint32_t p = 0; p < g.surface.size(); ++p) {
+    if (g.surface[p] != bake::kNoSurface && g.env_texel[p] != bake::kNoSurface) {
+      seen.push_back(p);
+      origins.push_back(g.point[p] + kRayOffsetM * g.normal[p]);
+    }
+  }
+  const int steps = std::max(2, static_cast<int>(std::ceil(std::abs(north_offset_deg) / 0.1)));
+  std::vector<uint8_t> first(seen.size()), now(seen.size()), differs(seen.size(), 0);
+  for (int k = 0; k <= steps; ++k) {
+    const glm::vec3 sun = SunWith(scene, scene.envmap->time_utc, north_offset_deg * k / steps, 0.0);
+    std::vector<uint8_t>& v = k == 0 ? first : now;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, seen.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
+      caster.OccludedAlong(origins.data() + range.begin(), range.size(), sun, 0.0f, v.data() + range.begin());
+      for (size_t i = range.begin(); i != range.end(); ++i) v[i] = !v[i] && glm::dot(g.normal[seen[i]], sun) > 0.0f;
+    });
+    for (size_t i = 0; k > 0 && i < seen.size(); ++i) differs[i] |= now[i] != first[i];
+  }
+  for (size_t i = 0; i < seen.size(); ++i) mask[seen[i]] = differs[i];
+  // The env map's texels are coarser than the camera's pixels: its albedo errs a little beyond.
+  std::vector<uint8_t> grown = mask;
+  for (int y = 0; y < g.height; ++y) {
+    for (int x = 0; x < g.width; ++x) {
+      if (!mask[static_cast<size_t>(y) * g.width + x]) continue;
+      for (int dy = -2; dy <= 2; ++dy) {
+        for (int dx = -2; dx <= 2; ++dx) {
+          const int yy = y + dy, xx = x + dx;
+          if (yy >= 0 && yy < g.height && xx >= 0 && xx < g.width) grown[static_cast<size_t>(yy) * g.width + xx] = 1;
+        }
+      }
+    }
+  }
+  return grown;
+}
+
+FitResult Calibrate(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                    const ShadowObservations& observed, const FitOptions& options, size_t* excluded) {
+  const FitResult first = FitNorthAndClock(scene, bake, caster, observed, options);
+  if (excluded != nullptr) *excluded = 0;
+  if (!first.north_fitted || first.at_range_edge || std::abs(first.north_offset_deg) < 0.1) return first;
+  const std::vector<uint8_t> mask = CaptureEdgeMask(scene, bake, caster, first.north_offset_deg);
+  ShadowObservations kept = observed;
+  size_t left_out = 0;
+  for (BurstShadows& b : kept.bursts) {
+    size_t n = 0;
+    for (size_t i = 0; i < b.pixels.size(); ++i) {
+      if (mask[b.pixels[i]]) continue;
+      b.pixels[n] = b.pixels[i], b.sunlit[n] = b.sunlit[i], ++n;
+    }
+    left_out += b.pixels.size() - n;
+    b.pixels.resize(n), b.sunlit.resize(n);
+  }
+  if (excluded != nullptr) *excluded = left_out;
+  Log().info("calibrate: north {:+.3f} deg at first; again without the {} pixels whose albedo it put on the wrong side of "
+             "the capture's shadow edges",
+             first.north_offset_deg, left_out);
+  FitResult second = FitNorthAndClock(scene, bake, caster, kept, options);
+  second.disagree_before = first.disagree_before;
+  return second;
+}
+
+std::optional<ShadowCheck> CheckShadows(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                                        const ShadowObservations& observed) {
+  if (observed.bursts.empty()) return std::nullopt;
+  FitOptions options;
+  options.clock = false;
+  options.north_range_deg = 3.0, options.north_step_deg = 0.5, options.north_tolerance_deg = 0.05;
+  options.coarse_stride = 4;
+  const FitResult fit = FitNorthAndClock(scene, bake, caster, observed, options);
+  return ShadowCheck{fit.disagree_before, fit.north_offset_deg, fit.edge_pixels};
+}
+
+}  // namespace daylit::calibrate
