@@ -6,6 +6,7 @@
 #include <numeric>
 #include <utility>
 
+#include <fmt/format.h>
 #include <glm/gtc/constants.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -427,6 +428,22 @@ FitResult FitNorthAndClock(const scene::Scene& scene, const bake::SceneBake& bak
     if (options.clock) result.clock_sigma_s = width(false, options.clock_tolerance_s * 2.0, 2.0 * options.clock_step_s);
   }
   return result;
+}
+
+std::string EnvMapSunBeyondRange(const scene::Scene& scene, const bake::SceneBake& bake, double north_range_deg) {
+  if (!scene.envmap || !bake.capture_sun.above_horizon) return {};
+  const glm::vec3 at = SunWith(scene, scene.envmap->time_utc, 0.0, 0.0);
+  double reach = 0.0;  // how far a north within the range moves the capture's sun
+  for (double north : {-north_range_deg, north_range_deg}) {
+    const glm::vec3 moved = SunWith(scene, scene.envmap->time_utc, north, 0.0);
+    reach = std::max(reach, glm::degrees(std::acos(std::clamp(static_cast<double>(glm::dot(at, moved)), -1.0, 1.0))));
+  }
+  const double offset = bake.capture_sun.brightest_offset_deg;
+  if (offset <= reach + 1.0) return {};
+  return fmt::format("the env map's sun lies {:.1f} deg from where the scene puts it at envmap.time_utc, beyond the {:.1f} deg "
+                     "a north within ±{:g} deg could explain: north_azimuth_deg (or envmap.time_utc) is off by more than the "
+                     "search covers",
+                     offset, reach, north_range_deg);
 }
 
 std::vector<uint8_t> CaptureEdgeMask(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,

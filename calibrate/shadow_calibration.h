@@ -135,6 +135,12 @@ FitResult Calibrate(const scene::Scene& scene, const bake::SceneBake& bake, cons
 std::vector<uint8_t> CaptureEdgeMask(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
                                      double north_offset_deg);
 
+// When the env map's own sun (its brightest texel, bake::CaptureSun) lies further from the
+// ephemeris sun at capture than any north within ±`north_range_deg` could move it (plus 1°), a
+// message saying so: the scene's north (or envmap.time_utc) is off beyond the search. Empty
+// otherwise, or without an env map with the sun above the horizon.
+std::string EnvMapSunBeyondRange(const scene::Scene& scene, const bake::SceneBake& bake, double north_range_deg);
+
 // The unit direction toward the sun at `utc` + `clock_offset_s`, for the scene with its north moved
 // by `north_offset_deg`.
 glm::vec3 SunWith(const scene::Scene& scene, const UtcTime& utc, double north_offset_deg, double clock_offset_s);

@@ -33,6 +33,7 @@ struct CalibrateSceneOptions {
   std::string figures;
   double north_range_deg = 10.0;
   double clock_range_min = 30.0;
+  int frames = 0;
 };
 
 // The JSON pointers of scene.json's fields that name files or folders (recording-format.md).
@@ -97,8 +98,14 @@ void RunCalibrateSceneCommand(const CalibrateSceneOptions& o) {
   Log().info("{} the bake: {}", loaded ? "loaded" : "made", dir.string());
   const scene::RayCaster caster(scene.model);
 
+  if (north) {
+    const std::string beyond = calibrate::EnvMapSunBeyondRange(scene, baked, o.north_range_deg);
+    if (!beyond.empty()) {
+      ThrowInputError("{}: {}; widen --north-range or correct it by hand; the scene is left as it was", scene.file.string(), beyond);
+    }
+  }
   const auto start = std::chrono::steady_clock::now();
-  const calibrate::ShadowObservations observed = calibrate::ObserveShadows(scene, baked, caster);
+  const calibrate::ShadowObservations observed = calibrate::ObserveShadows(scene, baked, caster, {.max_frames = o.frames});
   calibrate::FitOptions options;
   options.north = north, options.clock = clock;
   options.north_range_deg = o.north_range_deg, options.clock_range_s = 60.0 * o.clock_range_min;
@@ -168,6 +175,7 @@ void AddCalibrateSceneCommand(CLI::App& app) {
   cmd->add_option("--clock-range", options->clock_range_min, "Minutes searched either side of the frames' clock (default 30)")
       ->check(CLI::Range(1.0, 180.0));
   cmd->add_option("--figures", options->figures, "The fit's figures as JSON");
+  cmd->add_option("--frames", options->frames, "Read only the first N frames")->check(FrameCount());
   cmd->callback([options] { RunCalibrateSceneCommand(*options); });
 }
 
