@@ -8,6 +8,9 @@
 
 #include <fmt/format.h>
 #include <glm/gtc/constants.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -81,6 +84,8 @@ BurstShadows MedianShadows(const bake::CameraGBuffer& g, const std::vector<uint3
 // A burst's rays: origins off the surface and normals, in the order of its pixels.
 struct BurstRays {
   std::vector<glm::vec3> origin, normal;
+  std::vector<uint8_t> hit;             // 0: the pixel sees no model (under a rotated pose)
+  std::vector<glm::dvec3> camera_dir;   // its ray in camera coordinates
 };
 
 // The search's state: every burst's rays and σ, and the sun of each burst for given offsets.
@@ -89,13 +94,41 @@ class ShadowScore {
   ShadowScore(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
               const ShadowObservations& observed)
       : scene_(scene), caster_(caster), observed_(observed) {
+    const glm::dmat3& cam_from_world = scene.cam_from_world.rotation;
+    const scene::CameraModel camera = scene.Camera();
     for (const BurstShadows& b : observed.bursts) {
       BurstRays r;
+      std::vector<glm::dvec2> pixels;
       for (uint32_t p : b.pixels) {
         r.normal.push_back(bake.camera.normal[p]);
         r.origin.push_back(bake.camera.point[p] + kRayOffsetM * bake.camera.normal[p]);
+        r.hit.push_back(1);
+        pixels.push_back({static_cast<double>(p % static_cast<uint32_t>(bake.camera.width)),
+                          static_cast<double>(p / static_cast<uint32_t>(bake.camera.width))});
       }
+      for (const glm::dvec3& d : camera.UnprojectToWorldRays(pixels)) r.camera_dir.push_back(cam_from_world * d);
       rays_.push_back(std::move(r));
+    }
+  }
+
+  // The rays of a camera rotated by `rotation_deg` (RotatedPose): each pixel's point is where its
+  // ray from the camera's centre now meets the model (none: it sees the sky, V = 0).
+  void UsePose(const glm::dvec3& rotation_deg) {
+    const scene::RigidPose pose = RotatedPose(scene_.cam_from_world, rotation_deg);
+    const glm::dmat3 world_from_cam = glm::transpose(pose.rotation);
+    const glm::vec3 centre(pose.CenterInWorld());
+    for (size_t b = 0; b < rays_.size(); ++b) {
+      BurstRays& r = rays_[b];
+      const size_t n = r.camera_dir.size();
+      std::vector<glm::vec3> origins(n, centre), dirs(n);
+      for (size_t i = 0; i < n; ++i) dirs[i] = glm::vec3(glm::normalize(world_from_cam * r.camera_dir[i]));
+      std::vector<scene::RayHit> hits(n);
+      caster_.IntersectMany(origins.data(), dirs.data(), n, 0.0f, hits.data());
+      for (size_t i = 0; i < n; ++i) {
+        r.hit[i] = hits[i].IsHit();
+        r.normal[i] = r.hit[i] ? hits[i].normal : glm::vec3(0.0f);
+        r.origin[i] = r.hit[i] ? centre + hits[i].t * dirs[i] + kRayOffsetM * hits[i].normal : centre;
+      }
     }
   }
 
@@ -116,9 +149,54 @@ class ShadowScore {
       occluded.resize(origins.size());
       caster_.OccludedAlong(origins.data(), origins.size(), sun, 0.0f, occluded.data());
       for (size_t i = range.begin(); i != range.end(); ++i) {
-        (*v)[i] = !occluded[i - range.begin()] && glm::dot(r.normal[which[i]], sun) > 0.0f;
+        (*v)[i] = r.hit[which[i]] && !occluded[i - range.begin()] && glm::dot(r.normal[which[i]], sun) > 0.0f;
       }
     });
+  }
+
+  // V of the listed pixels of burst `b` seen by the camera rotated by `rotation_deg` (their rays
+  // meet the model anew), for the offsets.
+  void PoseVisibility(size_t b, const std::vector<uint32_t>& which, const glm::dvec3& rotation_deg, double north,
+                      double clock, std::vector<uint8_t>* v) const {
+    const glm::vec3 sun = SunWith(scene_, observed_.bursts[b].time, north, clock);
+    v->assign(which.size(), 0);
+    if (sun.z <= 0.0f || which.empty()) return;
+    const scene::RigidPose pose = RotatedPose(scene_.cam_from_world, rotation_deg);
+    const glm::dmat3 world_from_cam = glm::transpose(pose.rotation);
+    const glm::vec3 centre(pose.CenterInWorld());
+    const BurstRays& r = rays_[b];
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, which.size(), 1024), [&](const tbb::blocked_range<size_t>& range) {
+      thread_local std::vector<glm::vec3> dirs, lit_origins;
+      thread_local std::vector<scene::RayHit> hits;
+      thread_local std::vector<uint8_t> occluded;
+      thread_local std::vector<size_t> lit;
+      const size_t n = range.size();
+      dirs.resize(n), hits.resize(n);
+      for (size_t i = 0; i < n; ++i) dirs[i] = glm::vec3(glm::normalize(world_from_cam * r.camera_dir[which[range.begin() + i]]));
+      for (size_t i = 0; i < n; ++i) hits[i] = caster_.Intersect(centre, dirs[i]);
+      lit_origins.clear(), lit.clear();
+      for (size_t i = 0; i < n; ++i) {
+        if (!hits[i].IsHit() || glm::dot(hits[i].normal, sun) <= 0.0f) continue;
+        lit_origins.push_back(centre + hits[i].t * dirs[i] + kRayOffsetM * hits[i].normal);
+        lit.push_back(range.begin() + i);
+      }
+      occluded.resize(lit.size());
+      caster_.OccludedAlong(lit_origins.data(), lit_origins.size(), sun, 0.0f, occluded.data());
+      for (size_t k = 0; k < lit.size(); ++k) (*v)[lit[k]] = !occluded[k];
+    });
+  }
+
+  // Σ |σ − V| over the listed pixels of each burst, per burst, for the rotated camera.
+  std::vector<double> PerBurstPose(const std::vector<std::vector<uint32_t>>& which, const glm::dvec3& rotation_deg,
+                                   double north, double clock) const {
+    std::vector<double> score(bursts(), 0.0);
+    std::vector<uint8_t> v;
+    for (size_t b = 0; b < bursts(); ++b) {
+      PoseVisibility(b, which[b], rotation_deg, north, clock, &v);
+      const std::vector<float>& sigma = observed_.bursts[b].sunlit;
+      for (size_t i = 0; i < which[b].size(); ++i) score[b] += std::abs(sigma[which[b][i]] - static_cast<float>(v[i]));
+    }
+    return score;
   }
 
   // Σ |σ − V| over the listed pixels of each burst (`which[b]`), per burst.
@@ -206,8 +284,26 @@ glm::vec3 SunWith(const scene::Scene& scene, const UtcTime& utc, double north_of
 ShadowObserver::ShadowObserver(const scene::Scene& scene, const bake::SceneBake& bake, const ObserveOptions& options)
     : scene_(scene), bake_(bake), options_(options), linearizer_(scene.response) {
   const bake::CameraGBuffer& g = bake.camera;
+  std::vector<uint8_t> near(g.surface.size(), 0);
+  const int r = options.silhouette_margin_px;
+  if (r > 0) {
+    const int w = g.width, h = g.height;
+    cv::Mat edges(h, w, CV_8UC1, cv::Scalar(0));
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const uint32_t s = g.surface[static_cast<size_t>(y) * w + x];
+        if ((x + 1 < w && g.surface[static_cast<size_t>(y) * w + x + 1] != s) ||
+            (y + 1 < h && g.surface[static_cast<size_t>(y + 1) * w + x] != s)) {
+          edges.at<uint8_t>(y, x) = 255;
+        }
+      }
+    }
+    cv::Mat grown;
+    cv::dilate(edges, grown, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
+    for (size_t p = 0; p < near.size(); ++p) near[p] = grown.data[p] != 0;
+  }
   for (uint32_t p = 0; p < g.surface.size(); ++p) {
-    if (g.diffuse[p] && g.surface[p] != bake::kNoSurface) diffuse_.push_back(p);
+    if (g.diffuse[p] && g.surface[p] != bake::kNoSurface && !near[p]) diffuse_.push_back(p);
   }
 }
 
@@ -293,8 +389,11 @@ ShadowObservations ObserveShadows(const scene::Scene& scene, const bake::SceneBa
   return out;
 }
 
-FitResult FitNorthAndClock(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
-                           const ShadowObservations& observed, const FitOptions& requested) {
+namespace {
+
+// FitNorthAndClock on the rays of `score` (the bake's camera, or a rotated one).
+FitResult FitWithScore(const scene::Scene& scene, const ShadowObservations& observed, const ShadowScore& score,
+                       const FitOptions& requested) {
   if (observed.bursts.empty()) {
     ThrowInputError("{}: no burst of the {} shows the sun on the model's diffuse surfaces (overcast, or the sun on none "
                     "of them): the footage cannot constrain north or the clock",
@@ -319,7 +418,6 @@ FitResult FitNorthAndClock(const scene::Scene& scene, const bake::SceneBake& bak
   }
   if (!options.north && !options.clock) ThrowInputError("calibrate: nothing to fit (give north or clock)");
   result.north_fitted = options.north, result.clock_fitted = options.clock;
-  const ShadowScore score(scene, bake, caster, observed);
   const size_t bursts = score.bursts();
 
   // The coarse grid over every n-th pixel.
@@ -430,6 +528,98 @@ FitResult FitNorthAndClock(const scene::Scene& scene, const bake::SceneBake& bak
   return result;
 }
 
+
+// The camera rotation (degrees, axis-angle in camera coordinates) whose view puts the model's
+// shadows on σ, and with `north` the north offset with it (a turn of the camera about the vertical
+// and a turn of the sun about it trade against each other, so they are searched together): a
+// pattern search from `start`, moving each coordinate and each pair with north by ±step until the
+// centre is best, then half the step, from `first_step_deg` to under 0.01°; rotations within
+// ±range. `leave_out`: a burst left out of the score (the jackknife), or −1.
+struct PoseAndNorth {
+  glm::dvec3 rotation{0.0};
+  double north = 0.0;
+};
+PoseAndNorth FitRotation(const ShadowScore& score, const std::vector<std::vector<uint32_t>>& which, PoseAndNorth start,
+                         double clock, bool north, double range_deg, double first_step_deg, int leave_out) {
+  const auto total = [&](const PoseAndNorth& p) { return Sum(score.PerBurstPose(which, p.rotation, p.north, clock), leave_out); };
+  // Moves: ±1 on one coordinate (3 rotations, north), and with north, ±1 on a rotation and ±1 on north.
+  std::vector<glm::dvec4> moves;
+  for (int axis = 0; axis < (north ? 4 : 3); ++axis) {
+    for (int side : {-1, 1}) {
+      glm::dvec4 m(0.0);
+      m[axis] = side;
+      moves.push_back(m);
+    }
+  }
+  for (int axis = 0; north && axis < 3; ++axis) {
+    for (int a : {-1, 1}) {
+      for (int b : {-1, 1}) {
+        glm::dvec4 m(0.0);
+        m[axis] = a, m[3] = b;
+        moves.push_back(m);
+      }
+    }
+  }
+  PoseAndNorth best = start;
+  double best_score = total(best);
+  for (double step = first_step_deg; step >= 0.01; step *= 0.5) {
+    for (int move = 0; move < 8; ++move) {
+      const PoseAndNorth centre = best;
+      for (const glm::dvec4& m : moves) {
+        PoseAndNorth p = centre;
+        for (int axis = 0; axis < 3; ++axis) p.rotation[axis] = std::clamp(p.rotation[axis] + m[axis] * step, -range_deg, range_deg);
+        p.north += m[3] * step;
+        const double s = total(p);
+        if (s < best_score) best_score = s, best = p;
+      }
+      if (best.rotation == centre.rotation && best.north == centre.north) break;
+    }
+  }
+  return best;
+}
+
+// The pixels (every second one) whose side changes when the camera turns by 1° either way about
+// any axis from `rotation_deg`: where a rotation shows in the score.
+std::vector<std::vector<uint32_t>> PoseBand(const ShadowScore& score, const glm::dvec3& rotation_deg, const Offsets& offsets) {
+  std::vector<std::vector<uint32_t>> band(score.bursts());
+  std::vector<uint8_t> base, v;
+  for (size_t b = 0; b < score.bursts(); ++b) {
+    std::vector<uint32_t> every;
+    for (uint32_t i = 0; i < score.pixels(b); i += 2) every.push_back(i);
+    score.PoseVisibility(b, every, rotation_deg, offsets.north, offsets.clock, &base);
+    std::vector<uint8_t> changes(every.size(), 0);
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int side : {-1, 1}) {
+        glm::dvec3 r = rotation_deg;
+        r[axis] += side * 1.0;
+        score.PoseVisibility(b, every, r, offsets.north, offsets.clock, &v);
+        for (size_t k = 0; k < v.size(); ++k) changes[k] |= v[k] != base[k];
+      }
+    }
+    for (size_t k = 0; k < every.size(); ++k) {
+      if (changes[k]) band[b].push_back(every[k]);
+    }
+  }
+  return band;
+}
+
+}  // namespace
+
+scene::RigidPose RotatedPose(const scene::RigidPose& cam_from_world, const glm::dvec3& rotation_deg) {
+  const glm::dvec3 w = glm::radians(rotation_deg);
+  const double angle = glm::length(w);
+  glm::dmat3 delta(1.0);
+  if (angle > 0.0) {
+    const cv::Mat rodrigues = (cv::Mat_<double>(3, 1) << w.x, w.y, w.z);
+    cv::Mat m;
+    cv::Rodrigues(rodrigues, m);
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) delta[c][r] = m.at<double>(r, c);  // glm is column-major
+    }
+  }
+  return {delta * cam_from_world.rotation, delta * cam_from_world.translation};
+}
+
 std::string EnvMapSunBeyondRange(const scene::Scene& scene, const bake::SceneBake& bake, double north_range_deg) {
   if (!scene.envmap || !bake.capture_sun.above_horizon) return {};
   const glm::vec3 at = SunWith(scene, scene.envmap->time_utc, 0.0, 0.0);
@@ -444,6 +634,11 @@ std::string EnvMapSunBeyondRange(const scene::Scene& scene, const bake::SceneBak
                      "a north within ±{:g} deg could explain: north_azimuth_deg (or envmap.time_utc) is off by more than the "
                      "search covers",
                      offset, reach, north_range_deg);
+}
+
+FitResult FitNorthAndClock(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                           const ShadowObservations& observed, const FitOptions& options) {
+  return FitWithScore(scene, observed, ShadowScore(scene, bake, caster, observed), options);
 }
 
 std::vector<uint8_t> CaptureEdgeMask(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
@@ -487,11 +682,52 @@ std::vector<uint8_t> CaptureEdgeMask(const scene::Scene& scene, const bake::Scen
   return grown;
 }
 
+namespace {
+
+// The north/clock fit, then the camera's rotation with them held, north and clock again from the
+// rotated camera, and the rotation once more; the rotation's σ by the jackknife over bursts.
+FitResult WithPose(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
+                   const ShadowObservations& observed, const FitOptions& options, const FitResult& fit) {
+  ShadowScore score(scene, bake, caster, observed);
+  const bool north = fit.north_fitted;
+  PoseAndNorth pose{glm::dvec3(0.0), fit.north_offset_deg};
+  pose = FitRotation(score, PoseBand(score, pose.rotation, {pose.north, fit.clock_offset_s}), pose, fit.clock_offset_s, north,
+                     options.pose_range_deg, 0.25, -1);
+  // North and the clock again from the rotated camera, then the rotation (and north) once more.
+  score.UsePose(pose.rotation);
+  FitResult refit = FitWithScore(scene, observed, score, options);
+  const Offsets offsets{refit.north_offset_deg, refit.clock_offset_s};
+  const std::vector<std::vector<uint32_t>> band = PoseBand(score, pose.rotation, offsets);
+  pose = FitRotation(score, band, {pose.rotation, refit.north_offset_deg}, refit.clock_offset_s, north, options.pose_range_deg,
+                     0.1, -1);
+  refit.north_offset_deg = pose.north;
+  refit.pose_fitted = true;
+  refit.rotation_deg = pose.rotation;
+  refit.disagree_before = fit.disagree_before;
+  const size_t bursts = score.bursts();
+  if (bursts >= 3) {
+    std::vector<PoseAndNorth> leave(bursts);
+    glm::dvec3 mean(0.0);
+    for (size_t b = 0; b < bursts; ++b) {
+      leave[b] = FitRotation(score, band, pose, refit.clock_offset_s, north, options.pose_range_deg, 0.05, static_cast<int>(b));
+      mean += leave[b].rotation / static_cast<double>(bursts);
+    }
+    glm::dvec3 var(0.0);
+    for (const PoseAndNorth& r : leave) var += (r.rotation - mean) * (r.rotation - mean);
+    refit.rotation_sigma_deg = glm::sqrt(var * ((static_cast<double>(bursts) - 1.0) / static_cast<double>(bursts)));
+  }
+  return refit;
+}
+
+}  // namespace
+
 FitResult Calibrate(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
                     const ShadowObservations& observed, const FitOptions& options, size_t* excluded) {
   const FitResult first = FitNorthAndClock(scene, bake, caster, observed, options);
   if (excluded != nullptr) *excluded = 0;
-  if (!first.north_fitted || first.at_range_edge || std::abs(first.north_offset_deg) < 0.1) return first;
+  if (!first.north_fitted || first.at_range_edge || std::abs(first.north_offset_deg) < 0.1) {
+    return options.pose && !first.at_range_edge ? WithPose(scene, bake, caster, observed, options, first) : first;
+  }
   const std::vector<uint8_t> mask = CaptureEdgeMask(scene, bake, caster, first.north_offset_deg);
   ShadowObservations kept = observed;
   size_t left_out = 0;
@@ -510,7 +746,7 @@ FitResult Calibrate(const scene::Scene& scene, const bake::SceneBake& bake, cons
              first.north_offset_deg, left_out);
   FitResult second = FitNorthAndClock(scene, bake, caster, kept, options);
   second.disagree_before = first.disagree_before;
-  return second;
+  return options.pose && !second.at_range_edge ? WithPose(scene, bake, caster, kept, options, second) : second;
 }
 
 std::optional<ShadowCheck> CheckShadows(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,

@@ -31,6 +31,9 @@ struct ObserveOptions {
   double min_sun_to_sky = 1.0;      // a frame counts as clear when Σ E_sun / Σ E_sky is at least this
   double min_cos = 0.15;            // pixels whose normal is nearer the sun's grazing angle are left out
   int max_frames = 0;               // 0: the whole recording
+  // Pixels this close to an edge between two surfaces (or the sky) in the bake's G-buffer are left
+  // out: where the pose is off, they show the other surface (pose refinement sets ~a degree's worth).
+  int silhouette_margin_px = 0;
 };
 
 // One burst's view of the shadows.
@@ -89,6 +92,8 @@ ShadowObservations ObserveShadows(const scene::Scene& scene, const bake::SceneBa
 
 struct FitOptions {
   bool north = true, clock = true;
+  bool pose = false;                 // also a small camera rotation (within ±pose_range_deg per axis)
+  double pose_range_deg = 2.0;
   double north_range_deg = 10.0;     // searched either side of the scene's north
   double clock_range_s = 1800.0;     // and of its clock
   double north_step_deg = 1.0;       // of the coarse grid
@@ -100,6 +105,10 @@ struct FitOptions {
   // sun's path, so only north is fitted and the clock held (FitResult::note says so).
   double min_span_for_both_s = 1800.0;
 };
+
+// A small rotation of the camera about its own centre: an axis-angle vector in camera coordinates
+// (x right, y down, z forward), degrees. world_to_camera becomes Rδ·R, its translation Rδ·t.
+scene::RigidPose RotatedPose(const scene::RigidPose& cam_from_world, const glm::dvec3& rotation_deg);
 
 struct FitResult {
   bool north_fitted = false, clock_fitted = false;
@@ -114,6 +123,11 @@ struct FitResult {
   double disagree_before = 0.0;      // share of the edge pixels on the wrong side at the scene's values
   double disagree_after = 0.0;       // and at the fitted ones
   bool at_range_edge = false;        // the best lies on the search range's edge: the truth may be beyond it
+  // With pose refinement (FitOptions::pose): the camera's rotation (RotatedPose) that puts the
+  // model's shadows and edges on the frame's, and its jackknife σ per axis.
+  bool pose_fitted = false;
+  glm::dvec3 rotation_deg{0.0};
+  glm::dvec3 rotation_sigma_deg{0.0};
   std::string note;                  // what the footage could not separate, if anything
 };
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
 #include "apps/daylit/commands.h"
@@ -63,6 +64,20 @@ std::string CorrectedSceneJson(const scene::Scene& scene, const calibrate::FitRe
   nlohmann::ordered_json root = nlohmann::ordered_json::parse(text.str());
   if (fit.north_fitted) root["north_azimuth_deg"] = std::round((scene.north_azimuth_deg + fit.north_offset_deg) * 1e4) / 1e4;
   if (fit.clock_fitted) root["frames"]["clock_offset_s"] = std::round((scene.frames.clock_offset_s + fit.clock_offset_s) * 10.0) / 10.0;
+  if (fit.pose_fitted) {
+    const scene::RigidPose pose = calibrate::RotatedPose(scene.cam_from_world, fit.rotation_deg);
+    nlohmann::ordered_json rotation = nlohmann::ordered_json::array();
+    for (int r = 0; r < 3; ++r) {
+      rotation.push_back({std::round(pose.rotation[0][r] * 1e9) / 1e9, std::round(pose.rotation[1][r] * 1e9) / 1e9,
+                          std::round(pose.rotation[2][r] * 1e9) / 1e9});
+    }
+    root["camera"]["world_to_camera"] = {{"rotation", rotation},
+                                         {"translation", {pose.translation.x, pose.translation.y, pose.translation.z}}};
+    if (root["camera"].contains("correspondences")) {
+      root["camera"].erase("correspondences");
+      Log().info("the refined pose replaces camera.correspondences with camera.world_to_camera");
+    }
+  }
   const fs::path from = fs::weakly_canonical(out).parent_path(), to = fs::weakly_canonical(scene.folder);
   if (from != to) {
     for (const auto& ptr : PathFields(root)) {
@@ -75,7 +90,7 @@ std::string CorrectedSceneJson(const scene::Scene& scene, const calibrate::FitRe
 }
 
 void RunCalibrateSceneCommand(const CalibrateSceneOptions& o) {
-  bool north = false, clock = false;
+  bool north = false, clock = false, pose = false;
   std::stringstream what(o.what);
   for (std::string item; std::getline(what, item, ',');) {
     if (item == "north") {
@@ -83,9 +98,9 @@ void RunCalibrateSceneCommand(const CalibrateSceneOptions& o) {
     } else if (item == "clock") {
       clock = true;
     } else if (item == "pose") {
-      ThrowInputError("--what: pose refinement is not built yet (north and clock are)");
+      pose = true;
     } else {
-      ThrowInputError("--what: '{}' is not one of north, clock", item);
+      ThrowInputError("--what: '{}' is not one of north, clock, pose", item);
     }
   }
   if (!north && !clock) ThrowInputError("--what: give north, clock or both");
@@ -105,9 +120,9 @@ void RunCalibrateSceneCommand(const CalibrateSceneOptions& o) {
     }
   }
   const auto start = std::chrono::steady_clock::now();
-  const calibrate::ShadowObservations observed = calibrate::ObserveShadows(scene, baked, caster, {.max_frames = o.frames});
+  const calibrate::ShadowObservations observed = calibrate::ObserveShadows(scene, baked, caster, {.max_frames = o.frames, .silhouette_margin_px = pose ? 8 : 0});
   calibrate::FitOptions options;
-  options.north = north, options.clock = clock;
+  options.north = north, options.clock = clock, options.pose = pose;
   options.north_range_deg = o.north_range_deg, options.clock_range_s = 60.0 * o.clock_range_min;
   const calibrate::FitResult fit = calibrate::Calibrate(scene, baked, caster, observed, options);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -122,6 +137,11 @@ void RunCalibrateSceneCommand(const CalibrateSceneOptions& o) {
     fmt::print("  frames.clock_offset_s {:9.1f} -> {:9.1f}   ({:+.1f} ± {:.1f} s)\n", scene.frames.clock_offset_s,
                scene.frames.clock_offset_s + fit.clock_offset_s, fit.clock_offset_s, fit.clock_sigma_s);
   }
+  if (fit.pose_fitted) {
+    fmt::print("  camera rotation       ({:+.3f}, {:+.3f}, {:+.3f}) deg about its x, y, z (± {:.3f}, {:.3f}, {:.3f}): {:.3f} deg\n",
+               fit.rotation_deg.x, fit.rotation_deg.y, fit.rotation_deg.z, fit.rotation_sigma_deg.x, fit.rotation_sigma_deg.y,
+               fit.rotation_sigma_deg.z, glm::length(fit.rotation_deg));
+  }
   fmt::print("  edge pixels on the wrong side of the frames' shadows: {:.1f}% before, {:.1f}% after ({:.1f} s)\n",
              100.0 * fit.disagree_before, 100.0 * fit.disagree_after, seconds);
   if (!fit.note.empty()) fmt::print("  note: {}\n", fit.note);
@@ -133,7 +153,10 @@ void RunCalibrateSceneCommand(const CalibrateSceneOptions& o) {
                         {"bursts", fit.bursts},                     {"frames", fit.frames},
                         {"pixels", fit.pixels},                     {"edge_pixels", fit.edge_pixels},
                         {"disagree_before", fit.disagree_before},   {"disagree_after", fit.disagree_after},
-                        {"at_range_edge", fit.at_range_edge},       {"seconds", seconds}};
+                        {"at_range_edge", fit.at_range_edge},       {"seconds", seconds},
+                        {"pose_fitted", fit.pose_fitted},
+                        {"rotation_deg", {fit.rotation_deg.x, fit.rotation_deg.y, fit.rotation_deg.z}},
+                        {"rotation_sigma_deg", {fit.rotation_sigma_deg.x, fit.rotation_sigma_deg.y, fit.rotation_sigma_deg.z}}};
     WriteFileAtomically(o.figures, f.dump(2) + "\n");
   }
   if (fit.at_range_edge) {
@@ -169,7 +192,7 @@ void AddCalibrateSceneCommand(CLI::App& app) {
   cmd->add_option("recording", options->recording, "Recording folder or its scene.json")->required();
   cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
   cmd->add_option("--out", options->out, "The corrected scene.json")->required();
-  cmd->add_option("--what", options->what, "What to fit: north, clock or both, comma-separated (default north,clock)");
+  cmd->add_option("--what", options->what, "What to fit, comma-separated: north, clock, pose (a small camera rotation); default north,clock");
   cmd->add_option("--north-range", options->north_range_deg, "Degrees searched either side of the scene's north (default 10)")
       ->check(CLI::Range(0.5, 45.0));
   cmd->add_option("--clock-range", options->clock_range_min, "Minutes searched either side of the frames' clock (default 30)")
