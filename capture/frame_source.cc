@@ -236,6 +236,22 @@ class PacedSource final : public FrameSource {
   double done_s_ = 0.0;       // of which the stretches before the current one
 };
 
+class BorrowedSource final : public FrameSource {
+ public:
+  explicit BorrowedSource(FrameSource* source) : source_(source) {}
+  FrameStatus Next(Frame* frame) override {
+    const FrameStatus status = source_->Next(frame);
+    stats_ = source_->stats();
+    return status;
+  }
+  void Seek(int index) override { source_->Seek(index); }
+  std::string Describe() const override { return source_->Describe(); }
+  bool live() const override { return source_->live(); }
+
+ private:
+  FrameSource* source_;
+};
+
 class ClockShiftedSource final : public FrameSource {
  public:
   ClockShiftedSource(std::unique_ptr<FrameSource> source, double seconds) : source_(std::move(source)), seconds_(seconds) {}
@@ -272,6 +288,8 @@ std::unique_ptr<FrameSource> OpenVideoSource(const std::filesystem::path& video,
 std::unique_ptr<FrameSource> OpenImageSequence(std::string pattern, FrameTimes times, double exposure) {
   return std::make_unique<ImageSequence>(std::move(pattern), std::move(times), exposure);
 }
+
+std::unique_ptr<FrameSource> Borrowed(FrameSource* source) { return std::make_unique<BorrowedSource>(source); }
 
 std::unique_ptr<FrameSource> ClockShifted(std::unique_ptr<FrameSource> source, double seconds) {
   return std::make_unique<ClockShiftedSource>(std::move(source), seconds);

@@ -71,6 +71,10 @@ std::unique_ptr<FrameSource> OpenImageSequence(std::string pattern, FrameTimes t
 // The file of frame `index` for an image pattern.
 std::filesystem::path FramePath(const std::string& pattern, int index);
 
+// `source`, not owned: for a loop that reads the first frames of a source and hands the rest to
+// another (daylit live --calibrate). `source` must outlive it.
+std::unique_ptr<FrameSource> Borrowed(FrameSource* source);
+
 // `source` with `seconds` added to every frame's time: a camera clock that is known to be off
 // (scene.json's frames.clock_offset_s: UTC = the clock's time + offset).
 std::unique_ptr<FrameSource> ClockShifted(std::unique_ptr<FrameSource> source, double seconds);

@@ -11,6 +11,8 @@
 #include <fmt/format.h>
 
 #include "apps/daylit/commands.h"
+#include "apps/daylit/shadow_check.h"
+#include "calibrate/shadow_calibration.h"
 #include "bake/bake.h"
 #include "base/statistics.h"
 #include "base/error.h"
@@ -45,7 +47,47 @@ struct ReplayOptions {
   std::string screenshot;
   std::string relight_at;  // the time slider's start, HH:MM UTC
   std::string lighting = "volume";
+  double calibrate_s = 0.0;  // live: fit north on this many seconds of the camera first
 };
+
+// daylit live --calibrate: the camera's first `seconds` through the estimator, north fitted on
+// their shadows (one time of day: the clock is held), and the scene with it. The frames read go
+// only to the fit.
+scene::Scene CalibrateOnTheCamera(const scene::Scene& scene, const bake::SceneBake& baked, const scene::RayCaster& caster,
+                                  capture::FrameSource* source, double seconds, const std::atomic<bool>* stop) {
+  pipeline::LightingPipelineOptions options;
+  options.max_frames = std::max(1, static_cast<int>(std::lround(seconds * scene.frames.fps)));
+  options.progress_label = "calibrate";
+  options.stop = stop;
+  pipeline::LightingPipeline lighting(scene, baked, caster, options);
+  ShadowCheckSink shadows(scene, baked);
+  lighting.AddSink(&shadows);
+  lighting.Run(capture::Borrowed(source));
+  const calibrate::ShadowObservations observed = shadows.Finish();
+  scene::Scene calibrated = scene;
+  if (observed.bursts.empty()) {
+    Log().warn("--calibrate: the camera's first {:g} s show no clear sun on the model; north left at {:.3f} deg", seconds,
+               scene.north_azimuth_deg);
+    return calibrated;
+  }
+  calibrate::FitOptions fit_options;
+  fit_options.clock = false;
+  const calibrate::FitResult fit = calibrate::Calibrate(scene, baked, caster, observed, fit_options);
+  if (fit.at_range_edge) {
+    Log().warn("--calibrate: the shadows agree best at the search's edge (north {:+.1f} deg): north left at {:.3f} deg; "
+               "check north_azimuth_deg",
+               fit.north_offset_deg, scene.north_azimuth_deg);
+    return calibrated;
+  }
+  calibrated.north_azimuth_deg += fit.north_offset_deg;
+  Log().info("--calibrate: north {:.3f} -> {:.3f} deg ({:+.3f} ± {:.3f}) from {} frames of the camera, {} shadow-edge pixels "
+             "({:.1f}% on the wrong side before, {:.1f}% after); the clock held (one time of day); write "
+             "\"north_azimuth_deg\": {:.3f} into {} to keep it",
+             scene.north_azimuth_deg, calibrated.north_azimuth_deg, fit.north_offset_deg, fit.north_sigma_deg, fit.frames,
+             fit.edge_pixels, 100.0 * fit.disagree_before, 100.0 * fit.disagree_after, calibrated.north_azimuth_deg,
+             scene.file.string());
+  return calibrated;
+}
 
 // report.txt (also on stdout), estimates.csv, lighting.png and, with truth, the fidelity files.
 void WriteReplayReport(const scene::Scene& scene, const pipeline::PipelineRun& run, const render::FrameRenderer& renderer,
@@ -93,7 +135,8 @@ void RunReplay(const ReplayOptions& o) {
   pipeline::CheckVideoName(out);
   if (o.frames && *o.frames < 1) ThrowInputError("--frames: {} is not a number of frames", *o.frames);
   const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
-  const scene::Scene scene = scene::LoadScene(o.recording);
+  scene::Scene scene = scene::LoadScene(o.recording);
+  if (o.calibrate_s > 0.0 && !o.live) ThrowInputError("--calibrate: only for daylit live (a recording: daylit calibrate-scene)");
   if (o.live && scene.frames.kind != scene::FrameSourceKind::kDevice) {
     ThrowInputError("--scene: {}: frames name recorded frames, not a camera; replay them with daylit replay", scene.file.string());
   }
@@ -127,6 +170,8 @@ void RunReplay(const ReplayOptions& o) {
   Log().info("{} the bake: {}", loaded ? "loaded" : "made", cache.string());
 
   const scene::RayCaster caster(scene.model);
+  const StopOnInterrupt interrupt;
+  if (o.calibrate_s > 0.0) scene = CalibrateOnTheCamera(scene, baked, caster, source.get(), o.calibrate_s, interrupt.flag());
   render::FrameRenderer renderer(scene, baked, caster, render_options);
   pipeline::CompositeStage composite(scene, baked, caster, &renderer, &slider);
   evaluation::FidelitySink fidelity(scene);
@@ -134,7 +179,6 @@ void RunReplay(const ReplayOptions& o) {
   pipeline::LightingPipelineOptions options;
   options.max_frames = o.frames;
   options.progress_label = "replay";
-  const StopOnInterrupt interrupt;
   options.stop = interrupt.flag();
   pipeline::LightingPipeline lighting(scene, baked, caster, options);
   lighting.SetStage(&composite);
@@ -196,6 +240,10 @@ void AddLiveCommand(CLI::App& app) {
               "and white balance are locked as for daylit record. Opens the camera before the bake. Runs until\n"
               "--frames, Ctrl-C, or (with --window) the window is closed; the video and report are then complete.");
   cmd->add_option("--scene", options->recording, "scene.json whose frames name a camera")->required();
+  cmd->add_option("--calibrate", options->calibrate_s,
+                  "First fit north on this many seconds of the camera's frames (their shadows against the model's; "
+                  "daylit calibrate-scene's method, the clock held) and run on with it")
+      ->check(CLI::Range(1.0, 600.0));
   AddPipelineOptions(cmd, options, "live.mp4");
 }
 
