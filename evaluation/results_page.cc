@@ -90,7 +90,9 @@ void AddRunFigures(const nlohmann::json& json, const std::string& prefix, const 
   if (!json.is_object()) ThrowInputError("{}: figures are a JSON object of numbers and texts", source);
   for (const auto& [key, value] : json.items()) {
     const std::string name = prefix + "/" + key;
-    if (value.is_number()) {
+    if (value.is_boolean()) {
+      figures->numbers[name] = value.get<bool>() ? 1.0 : 0.0;
+    } else if (value.is_number()) {
       figures->numbers[name] = value.get<double>();
     } else if (value.is_string()) {
       figures->texts[name] = value.get<std::string>();
@@ -99,7 +101,7 @@ void AddRunFigures(const nlohmann::json& json, const std::string& prefix, const 
     } else if (value.is_object()) {
       AddRunFigures(value, name, source, figures);
     } else if (!value.is_array()) {
-      ThrowInputError("{}: \"{}\" is neither a number, a text, an object nor an array", source, name);
+      ThrowInputError("{}: \"{}\" is neither a number, a boolean, a text, an object nor an array", source, name);
     }
   }
 }

@@ -35,7 +35,17 @@ MeasuredFigures Figures() {
   AddTestFigures(nlohmann::json::parse(kGtestJson), "estimate_recording_test.json", &figures);
   AddRunFigures(nlohmann::json::parse(R"json({"fps": 41.23, "gl_renderer": "llvmpipe (LLVM 15.0.6, 256 bits)"})json"),
                 "courtyard-a/replay", "figures.json", &figures);
+  AddRunFigures(nlohmann::json::parse(R"json({"seconds": 10.9, "at_range_edge": false, "pose_fitted": true})json"),
+                "courtyard-a/calibrate", "calibrate.json", &figures);
   return figures;
+}
+
+// calibrate-scene's figures carry flags: 1 and 0.
+TEST(ResultsPage, FlagsAreOneAndZero) {
+  const MeasuredFigures figures = Figures();
+  EXPECT_EQ(figures.numbers.at("courtyard-a/calibrate/at_range_edge"), 0.0);
+  EXPECT_EQ(figures.numbers.at("courtyard-a/calibrate/pose_fitted"), 1.0);
+  EXPECT_DOUBLE_EQ(figures.numbers.at("courtyard-a/calibrate/seconds"), 10.9);
 }
 
 TEST(ResultsPage, MediansOfRepetitionsInSeconds) {

@@ -48,6 +48,13 @@ for recording in recordings/*/; do
   "$daylit" -q estimate "$recording" --cache "build/results-cache/$name" --out "$out/$name/estimates.csv" \
     --figures "$out/$name/estimate.json" --residuals "$out/$name/residuals" >/dev/null
   "$daylit" -q replay "$recording" --cache "build/results-cache/$name" --out "$out/$name/replay/replay.mp4" >/dev/null
+  # The scene's calibration from its footage (docs/calibrate.md), the bake cached: north and clock,
+  # then with the camera's rotation.
+  mkdir -p "$out/$name/calibrated"
+  "$daylit" -q calibrate-scene "$recording" --cache "build/results-cache/$name" --out "$out/$name/calibrated/scene.json" \
+    --figures "$out/$name/calibrate.json" >/dev/null
+  "$daylit" -q calibrate-scene "$recording" --cache "build/results-cache/$name" --out "$out/$name/calibrated/scene.json" \
+    --what north,clock,pose --figures "$out/$name/calibrate_pose.json" >/dev/null
 done
 
 # daylit live on the userspace V4L2 test device (tests/fakecam, docs/capture.md) serving
