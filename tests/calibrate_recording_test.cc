@@ -83,12 +83,10 @@ TEST_P(CalibrateRecordingTest, NorthWithinAThirdOfADegreeAndTheClockWithinAMinut
 
 INSTANTIATE_TEST_SUITE_P(
     Perturbations, CalibrateRecordingTest,
-    // Each sign and size once per recording (all twenty passed when measured, docs/calibrate.md);
-    // the suite keeps ten for CI's time.
-    ::testing::Values(Perturbation{"courtyard-a", 0.0, 0.0}, Perturbation{"courtyard-a", 1.0, 0.0},
-                      Perturbation{"courtyard-a", -3.0, 0.0}, Perturbation{"courtyard-a", 0.0, 600.0},
-                      Perturbation{"courtyard-a", -1.0, -120.0}, Perturbation{"courtyard-c", 0.0, 0.0},
-                      Perturbation{"courtyard-c", -1.0, 0.0}, Perturbation{"courtyard-c", 3.0, 0.0},
+    // Each kind once: unperturbed, north alone, clock alone, both (all twenty combinations passed
+    // when measured, docs/calibrate.md); six here for CI's time.
+    ::testing::Values(Perturbation{"courtyard-a", 0.0, 0.0}, Perturbation{"courtyard-a", -3.0, 0.0},
+                      Perturbation{"courtyard-a", -1.0, -120.0}, Perturbation{"courtyard-c", 3.0, 0.0},
                       Perturbation{"courtyard-c", 0.0, -600.0}, Perturbation{"courtyard-c", 1.0, 120.0}),
     Name);
 
