@@ -16,6 +16,7 @@
 
 #include "base/error.h"
 #include "base/log.h"
+#include "bake/surface_light.h"
 #include "base/progress.h"
 #include "capture/frame_source.h"
 #include "capture/read_ahead.h"
@@ -81,12 +82,20 @@ BurstShadows MedianShadows(const bake::CameraGBuffer& g, const std::vector<uint3
   return burst;
 }
 
-// A burst's rays: origins off the surface and normals, in the order of its pixels.
+// A burst's pixels as the search sees them: the surface point each one shows and its normal
+// (zero where it shows no model, under a rotated pose: never sunlit), and its ray in camera
+// coordinates.
 struct BurstRays {
-  std::vector<glm::vec3> origin, normal;
-  std::vector<uint8_t> hit;             // 0: the pixel sees no model (under a rotated pose)
-  std::vector<glm::dvec3> camera_dir;   // its ray in camera coordinates
+  std::vector<glm::vec3> point, normal;
+  std::vector<glm::dvec3> camera_dir;
 };
+
+// Σ |σ − V| over the listed pixels (`v` aligned with `which`).
+double Mismatch(const std::vector<float>& sigma, const std::vector<uint32_t>& which, const std::vector<uint8_t>& v) {
+  double s = 0.0;
+  for (size_t i = 0; i < which.size(); ++i) s += std::abs(sigma[which[i]] - static_cast<float>(v[i]));
+  return s;
+}
 
 // The search's state: every burst's rays and σ, and the sun of each burst for given offsets.
 class ShadowScore {
@@ -100,9 +109,8 @@ class ShadowScore {
       BurstRays r;
       std::vector<glm::dvec2> pixels;
       for (uint32_t p : b.pixels) {
+        r.point.push_back(bake.camera.point[p]);
         r.normal.push_back(bake.camera.normal[p]);
-        r.origin.push_back(bake.camera.point[p] + kRayOffsetM * bake.camera.normal[p]);
-        r.hit.push_back(1);
         pixels.push_back({static_cast<double>(p % static_cast<uint32_t>(bake.camera.width)),
                           static_cast<double>(p / static_cast<uint32_t>(bake.camera.width))});
       }
@@ -112,78 +120,33 @@ class ShadowScore {
   }
 
   // The rays of a camera rotated by `rotation_deg` (RotatedPose): each pixel's point is where its
-  // ray from the camera's centre now meets the model (none: it sees the sky, V = 0).
+  // ray from the camera's centre now meets the model.
   void UsePose(const glm::dvec3& rotation_deg) {
-    const scene::RigidPose pose = RotatedPose(scene_.cam_from_world, rotation_deg);
-    const glm::dmat3 world_from_cam = glm::transpose(pose.rotation);
-    const glm::vec3 centre(pose.CenterInWorld());
     for (size_t b = 0; b < rays_.size(); ++b) {
-      BurstRays& r = rays_[b];
-      const size_t n = r.camera_dir.size();
-      std::vector<glm::vec3> origins(n, centre), dirs(n);
-      for (size_t i = 0; i < n; ++i) dirs[i] = glm::vec3(glm::normalize(world_from_cam * r.camera_dir[i]));
-      std::vector<scene::RayHit> hits(n);
-      caster_.IntersectMany(origins.data(), dirs.data(), n, 0.0f, hits.data());
-      for (size_t i = 0; i < n; ++i) {
-        r.hit[i] = hits[i].IsHit();
-        r.normal[i] = r.hit[i] ? hits[i].normal : glm::vec3(0.0f);
-        r.origin[i] = r.hit[i] ? centre + hits[i].t * dirs[i] + kRayOffsetM * hits[i].normal : centre;
-      }
+      std::vector<uint32_t> every(rays_[b].camera_dir.size());
+      std::iota(every.begin(), every.end(), 0u);
+      SeenByRotatedCamera(b, every, rotation_deg, &rays_[b].point, &rays_[b].normal);
     }
   }
 
   size_t bursts() const { return rays_.size(); }
-  size_t pixels(size_t b) const { return rays_[b].origin.size(); }
+  size_t pixels(size_t b) const { return rays_[b].point.size(); }
 
   // V (1: the sun reaches it) of the listed pixels of burst `b` for the offsets.
   void Visibility(size_t b, const std::vector<uint32_t>& which, double north, double clock, std::vector<uint8_t>* v) const {
-    const glm::vec3 sun = SunWith(scene_, observed_.bursts[b].time, north, clock);
-    v->assign(which.size(), 0);
-    if (sun.z <= 0.0f) return;
-    const BurstRays& r = rays_[b];
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, which.size(), 2048), [&](const tbb::blocked_range<size_t>& range) {
-      thread_local std::vector<glm::vec3> origins;
-      thread_local std::vector<uint8_t> occluded;
-      origins.clear();
-      for (size_t i = range.begin(); i != range.end(); ++i) origins.push_back(r.origin[which[i]]);
-      occluded.resize(origins.size());
-      caster_.OccludedAlong(origins.data(), origins.size(), sun, 0.0f, occluded.data());
-      for (size_t i = range.begin(); i != range.end(); ++i) {
-        (*v)[i] = r.hit[which[i]] && !occluded[i - range.begin()] && glm::dot(r.normal[which[i]], sun) > 0.0f;
-      }
-    });
+    std::vector<glm::vec3> points, normals;
+    points.clear(), normals.clear();
+    for (uint32_t i : which) points.push_back(rays_[b].point[i]), normals.push_back(rays_[b].normal[i]);
+    SunVisibility(b, points, normals, north, clock, v);
   }
 
   // V of the listed pixels of burst `b` seen by the camera rotated by `rotation_deg` (their rays
   // meet the model anew), for the offsets.
   void PoseVisibility(size_t b, const std::vector<uint32_t>& which, const glm::dvec3& rotation_deg, double north,
                       double clock, std::vector<uint8_t>* v) const {
-    const glm::vec3 sun = SunWith(scene_, observed_.bursts[b].time, north, clock);
-    v->assign(which.size(), 0);
-    if (sun.z <= 0.0f || which.empty()) return;
-    const scene::RigidPose pose = RotatedPose(scene_.cam_from_world, rotation_deg);
-    const glm::dmat3 world_from_cam = glm::transpose(pose.rotation);
-    const glm::vec3 centre(pose.CenterInWorld());
-    const BurstRays& r = rays_[b];
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, which.size(), 1024), [&](const tbb::blocked_range<size_t>& range) {
-      thread_local std::vector<glm::vec3> dirs, lit_origins;
-      thread_local std::vector<scene::RayHit> hits;
-      thread_local std::vector<uint8_t> occluded;
-      thread_local std::vector<size_t> lit;
-      const size_t n = range.size();
-      dirs.resize(n), hits.resize(n);
-      for (size_t i = 0; i < n; ++i) dirs[i] = glm::vec3(glm::normalize(world_from_cam * r.camera_dir[which[range.begin() + i]]));
-      for (size_t i = 0; i < n; ++i) hits[i] = caster_.Intersect(centre, dirs[i]);
-      lit_origins.clear(), lit.clear();
-      for (size_t i = 0; i < n; ++i) {
-        if (!hits[i].IsHit() || glm::dot(hits[i].normal, sun) <= 0.0f) continue;
-        lit_origins.push_back(centre + hits[i].t * dirs[i] + kRayOffsetM * hits[i].normal);
-        lit.push_back(range.begin() + i);
-      }
-      occluded.resize(lit.size());
-      caster_.OccludedAlong(lit_origins.data(), lit_origins.size(), sun, 0.0f, occluded.data());
-      for (size_t k = 0; k < lit.size(); ++k) (*v)[lit[k]] = !occluded[k];
-    });
+    std::vector<glm::vec3> points, normals;
+    SeenByRotatedCamera(b, which, rotation_deg, &points, &normals);
+    SunVisibility(b, points, normals, north, clock, v);
   }
 
   // Σ |σ − V| over the listed pixels of each burst, per burst, for the rotated camera.
@@ -193,8 +156,7 @@ class ShadowScore {
     std::vector<uint8_t> v;
     for (size_t b = 0; b < bursts(); ++b) {
       PoseVisibility(b, which[b], rotation_deg, north, clock, &v);
-      const std::vector<float>& sigma = observed_.bursts[b].sunlit;
-      for (size_t i = 0; i < which[b].size(); ++i) score[b] += std::abs(sigma[which[b][i]] - static_cast<float>(v[i]));
+      score[b] = Mismatch(observed_.bursts[b].sunlit, which[b], v);
     }
     return score;
   }
@@ -204,12 +166,8 @@ class ShadowScore {
     std::vector<double> score(bursts(), 0.0);
     std::vector<uint8_t> v;
     for (size_t b = 0; b < bursts(); ++b) {
-      if (which[b].empty()) continue;
       Visibility(b, which[b], north, clock, &v);
-      const std::vector<float>& sigma = observed_.bursts[b].sunlit;
-      double s = 0.0;
-      for (size_t i = 0; i < which[b].size(); ++i) s += std::abs(sigma[which[b][i]] - static_cast<float>(v[i]));
-      score[b] = s;
+      score[b] = Mismatch(observed_.bursts[b].sunlit, which[b], v);
     }
     return score;
   }
@@ -219,7 +177,6 @@ class ShadowScore {
     size_t wrong = 0, all = 0;
     std::vector<uint8_t> v;
     for (size_t b = 0; b < bursts(); ++b) {
-      if (which[b].empty()) continue;
       Visibility(b, which[b], north, clock, &v);
       const std::vector<float>& sigma = observed_.bursts[b].sunlit;
       for (size_t i = 0; i < which[b].size(); ++i) wrong += std::abs(sigma[which[b][i]] - static_cast<float>(v[i])) > 0.5f;
@@ -229,6 +186,34 @@ class ShadowScore {
   }
 
  private:
+  // bake::SunVisibility of the points toward burst `b`'s sun for the offsets; none at night.
+  void SunVisibility(size_t b, const std::vector<glm::vec3>& points, const std::vector<glm::vec3>& normals, double north,
+                     double clock, std::vector<uint8_t>* v) const {
+    const glm::vec3 sun = SunWith(scene_, observed_.bursts[b].time, north, clock);
+    v->assign(points.size(), 0);
+    if (sun.z <= 0.0f) return;
+    bake::SunVisibility(caster_, points.data(), normals.data(), points.size(), sun, kRayOffsetM, v->data());
+  }
+
+  // Where the listed pixels of burst `b` meet the model when the camera is rotated by
+  // `rotation_deg` about its centre: points and normals (zero where they see no model).
+  void SeenByRotatedCamera(size_t b, const std::vector<uint32_t>& which, const glm::dvec3& rotation_deg,
+                           std::vector<glm::vec3>* points, std::vector<glm::vec3>* normals) const {
+    const scene::RigidPose pose = RotatedPose(scene_.cam_from_world, rotation_deg);
+    const glm::dmat3 world_from_cam = glm::transpose(pose.rotation);
+    const glm::vec3 centre(pose.CenterInWorld());
+    const size_t n = which.size();
+    std::vector<glm::vec3> origins(n, centre), dirs(n);
+    for (size_t i = 0; i < n; ++i) dirs[i] = glm::vec3(glm::normalize(world_from_cam * rays_[b].camera_dir[which[i]]));
+    std::vector<scene::RayHit> hits(n);
+    caster_.IntersectMany(origins.data(), dirs.data(), n, 0.0f, hits.data());
+    points->resize(n), normals->resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      (*points)[i] = hits[i].IsHit() ? centre + hits[i].t * dirs[i] : centre;
+      (*normals)[i] = hits[i].IsHit() ? hits[i].normal : glm::vec3(0.0f);
+    }
+  }
+
   const scene::Scene& scene_;
   const scene::RayCaster& caster_;
   const ShadowObservations& observed_;
@@ -447,11 +432,8 @@ FitResult FitWithScore(const scene::Scene& scene, const ShadowObservations& obse
       for (size_t b = 0; b < bursts; ++b) {
         score.Visibility(b, coarse[b], o.north, o.clock, &v);
         if (first_v[b].empty()) first_v[b] = v, seen[b].assign(v.size(), 0);
-        const std::vector<float>& sigma = observed.bursts[b].sunlit;
-        for (size_t k = 0; k < v.size(); ++k) {
-          s += std::abs(sigma[coarse[b][k]] - static_cast<float>(v[k]));
-          seen[b][k] |= v[k] != first_v[b][k];
-        }
+        s += Mismatch(observed.bursts[b].sunlit, coarse[b], v);
+        for (size_t k = 0; k < v.size(); ++k) seen[b][k] |= v[k] != first_v[b][k];
       }
       if (s < best_score) best_score = s, best = o;
       progress.Advance();
@@ -644,42 +626,27 @@ FitResult FitNorthAndClock(const scene::Scene& scene, const bake::SceneBake& bak
 std::vector<uint8_t> CaptureEdgeMask(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
                                      double north_offset_deg) {
   const bake::CameraGBuffer& g = bake.camera;
-  std::vector<uint8_t> mask(g.surface.size(), 0);
-  if (!scene.envmap) return mask;
+  if (!scene.envmap) return std::vector<uint8_t>(g.surface.size(), 0);
   std::vector<uint32_t> seen;  // pixels whose albedo is the env map's own texel's
-  std::vector<glm::vec3> origins;
+  std::vector<glm::vec3> points, normals;
   for (uint32_t p = 0; p < g.surface.size(); ++p) {
     if (g.surface[p] != bake::kNoSurface && g.env_texel[p] != bake::kNoSurface) {
       seen.push_back(p);
-      origins.push_back(g.point[p] + kRayOffsetM * g.normal[p]);
+      points.push_back(g.point[p]), normals.push_back(g.normal[p]);
     }
   }
   const int steps = std::max(2, static_cast<int>(std::ceil(std::abs(north_offset_deg) / 0.1)));
   std::vector<uint8_t> first(seen.size()), now(seen.size()), differs(seen.size(), 0);
   for (int k = 0; k <= steps; ++k) {
     const glm::vec3 sun = SunWith(scene, scene.envmap->time_utc, north_offset_deg * k / steps, 0.0);
-    std::vector<uint8_t>& v = k == 0 ? first : now;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, seen.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
-      caster.OccludedAlong(origins.data() + range.begin(), range.size(), sun, 0.0f, v.data() + range.begin());
-      for (size_t i = range.begin(); i != range.end(); ++i) v[i] = !v[i] && glm::dot(g.normal[seen[i]], sun) > 0.0f;
-    });
+    bake::SunVisibility(caster, points.data(), normals.data(), seen.size(), sun, kRayOffsetM, (k == 0 ? first : now).data());
     for (size_t i = 0; k > 0 && i < seen.size(); ++i) differs[i] |= now[i] != first[i];
   }
-  for (size_t i = 0; i < seen.size(); ++i) mask[seen[i]] = differs[i];
+  cv::Mat mask(g.height, g.width, CV_8UC1, cv::Scalar(0));
+  for (size_t i = 0; i < seen.size(); ++i) mask.data[seen[i]] = differs[i];
   // The env map's texels are coarser than the camera's pixels: its albedo errs a little beyond.
-  std::vector<uint8_t> grown = mask;
-  for (int y = 0; y < g.height; ++y) {
-    for (int x = 0; x < g.width; ++x) {
-      if (!mask[static_cast<size_t>(y) * g.width + x]) continue;
-      for (int dy = -2; dy <= 2; ++dy) {
-        for (int dx = -2; dx <= 2; ++dx) {
-          const int yy = y + dy, xx = x + dx;
-          if (yy >= 0 && yy < g.height && xx >= 0 && xx < g.width) grown[static_cast<size_t>(yy) * g.width + xx] = 1;
-        }
-      }
-    }
-  }
-  return grown;
+  cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
+  return std::vector<uint8_t>(mask.data, mask.data + mask.total());
 }
 
 namespace {
@@ -722,9 +689,8 @@ FitResult WithPose(const scene::Scene& scene, const bake::SceneBake& bake, const
 }  // namespace
 
 FitResult Calibrate(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
-                    const ShadowObservations& observed, const FitOptions& options, size_t* excluded) {
+                    const ShadowObservations& observed, const FitOptions& options) {
   const FitResult first = FitNorthAndClock(scene, bake, caster, observed, options);
-  if (excluded != nullptr) *excluded = 0;
   if (!first.north_fitted || first.at_range_edge || std::abs(first.north_offset_deg) < 0.1) {
     return options.pose && !first.at_range_edge ? WithPose(scene, bake, caster, observed, options, first) : first;
   }
@@ -740,7 +706,6 @@ FitResult Calibrate(const scene::Scene& scene, const bake::SceneBake& bake, cons
     left_out += b.pixels.size() - n;
     b.pixels.resize(n), b.sunlit.resize(n);
   }
-  if (excluded != nullptr) *excluded = left_out;
   Log().info("calibrate: north {:+.3f} deg at first; again without the {} pixels whose albedo it put on the wrong side of "
              "the capture's shadow edges",
              first.north_offset_deg, left_out);

@@ -140,9 +140,9 @@ FitResult FitNorthAndClock(const scene::Scene& scene, const bake::SceneBake& bak
 // of a capture-time shadow edge, were north off by what the first fit found (the bake derives
 // albedo with the capture's sun, so a north 3° off darkens or brightens a band along the env map's
 // shadow edges, and that band pulls the shadows toward the old north: by 0.2° at 3° on
-// courtyard-a). `excluded` (optional): how many pixels the second fit left out.
+// courtyard-a).
 FitResult Calibrate(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
-                    const ShadowObservations& observed, const FitOptions& options = {}, size_t* excluded = nullptr);
+                    const ShadowObservations& observed, const FitOptions& options = {});
 
 // 1 for the camera pixels whose albedo came from a capture-time sun on the other side of a shadow
 // edge for some north between the scene's and the scene's + `north_offset_deg` (dilated by 2 px).

@@ -2,7 +2,6 @@
 // fall (calibrate/shadow_calibration.h, docs/calibrate.md), written as a corrected scene.json.
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -15,7 +14,7 @@
 #include "bake/bake.h"
 #include "base/atomic_file.h"
 #include "base/error.h"
-#include "base/files.h"
+#include "base/csv.h"
 #include "base/log.h"
 #include "calibrate/shadow_calibration.h"
 #include "scene/raycaster.h"
@@ -58,10 +57,7 @@ std::vector<nlohmann::json::json_pointer> PathFields(const nlohmann::ordered_jso
 
 // scene.json with the fitted values, its file paths made to resolve from `out`'s folder.
 std::string CorrectedSceneJson(const scene::Scene& scene, const calibrate::FitResult& fit, const fs::path& out) {
-  std::ifstream in(scene.file);
-  std::stringstream text;
-  text << in.rdbuf();
-  nlohmann::ordered_json root = nlohmann::ordered_json::parse(text.str());
+  nlohmann::ordered_json root = nlohmann::ordered_json::parse(ReadTextFile(scene.file));
   if (fit.north_fitted) root["north_azimuth_deg"] = std::round((scene.north_azimuth_deg + fit.north_offset_deg) * 1e4) / 1e4;
   if (fit.clock_fitted) root["frames"]["clock_offset_s"] = std::round((scene.frames.clock_offset_s + fit.clock_offset_s) * 10.0) / 10.0;
   if (fit.pose_fitted) {
