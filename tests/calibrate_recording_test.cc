@@ -84,10 +84,10 @@ TEST_P(CalibrateRecordingTest, NorthWithinAThirdOfADegreeAndTheClockWithinAMinut
 INSTANTIATE_TEST_SUITE_P(
     Perturbations, CalibrateRecordingTest,
     // Each kind once: unperturbed, north alone, clock alone, both (all twenty combinations passed
-    // when measured, docs/calibrate.md); six here for CI's time.
-    ::testing::Values(Perturbation{"courtyard-a", 0.0, 0.0}, Perturbation{"courtyard-a", -3.0, 0.0},
-                      Perturbation{"courtyard-a", -1.0, -120.0}, Perturbation{"courtyard-c", 3.0, 0.0},
-                      Perturbation{"courtyard-c", 0.0, -600.0}, Perturbation{"courtyard-c", 1.0, 120.0}),
+    // when measured, docs/calibrate.md); four here for CI's time, and the end-to-end run below
+    // has both on courtyard-c.
+    ::testing::Values(Perturbation{"courtyard-a", 0.0, 0.0}, Perturbation{"courtyard-a", -1.0, -120.0},
+                      Perturbation{"courtyard-c", 3.0, 0.0}, Perturbation{"courtyard-c", 0.0, -600.0}),
     Name);
 
 // A folder whose scene.json is the recording's with north and clock moved, its other files linked.
