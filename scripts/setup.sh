@@ -10,7 +10,7 @@ packages=(
   libglm-dev libglfw3-dev libegl-dev libgl-dev libgles-dev libepoxy-dev libegl-mesa0
   libgl1-mesa-dri libgbm-dev libopenexr-dev libimath-dev libembree-dev libtbb-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
-  libspdlog-dev libfmt-dev libtinyobjloader-dev libtinygltf-dev libstb-dev liberfa-dev
+  libcpp-httplib-dev libspdlog-dev libfmt-dev libtinyobjloader-dev libtinygltf-dev libstb-dev liberfa-dev
   ffmpeg xvfb xauth clang libclang-rt-14-dev
 )
 

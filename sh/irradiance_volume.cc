@@ -137,14 +137,12 @@ glm::vec3 IrradianceVolume::Irradiance(const glm::vec3& point, const glm::vec3& 
   return glm::max(Integrate(point, EvalSh9(glm::dvec3(normal))), glm::vec3(0.0f));
 }
 
-void IrradianceVolume::Corners(const glm::vec3& point, std::array<size_t, 8>* probes, std::array<float, 8>* weights) const {
-  const glm::ivec3 n = gather_.resolution;
-  // Continuous probe coordinates, clamped into the grid.
+void TrilinearCorners(const glm::vec3& min, const glm::vec3& max, const glm::ivec3& n, const glm::vec3& point,
+                      std::array<size_t, 8>* indices, std::array<float, 8>* weights) {
+  // Continuous grid coordinates, clamped into the grid.
   glm::vec3 g;
   for (int a = 0; a < 3; ++a) {
-    g[a] = n[a] <= 1 ? 0.0f
-                     : std::clamp((point[a] - gather_.min[a]) / (gather_.max[a] - gather_.min[a]), 0.0f, 1.0f) *
-                           static_cast<float>(n[a] - 1);
+    g[a] = n[a] <= 1 ? 0.0f : std::clamp((point[a] - min[a]) / (max[a] - min[a]), 0.0f, 1.0f) * static_cast<float>(n[a] - 1);
   }
   const glm::ivec3 i0 = glm::min(glm::ivec3(g), glm::max(n - 2, glm::ivec3(0)));
   const glm::vec3 f = g - glm::vec3(i0);
@@ -153,9 +151,32 @@ void IrradianceVolume::Corners(const glm::vec3& point, std::array<size_t, 8>* pr
     const glm::ivec3 q = glm::min(i0 + o, n - 1);
     float w = 1.0f;
     for (int a = 0; a < 3; ++a) w *= o[a] ? f[a] : 1.0f - f[a];
-    (*probes)[static_cast<size_t>(corner)] = (static_cast<size_t>(q.z) * n.y + q.y) * n.x + q.x;
+    (*indices)[static_cast<size_t>(corner)] = (static_cast<size_t>(q.z) * n.y + q.y) * n.x + q.x;
     (*weights)[static_cast<size_t>(corner)] = w;
   }
+}
+
+std::array<float, 27> Sh9Snapshot::At(const glm::vec3& point) const {
+  std::array<float, 27> out{};
+  if (coefficients.empty()) return out;
+  std::array<size_t, 8> probes;
+  std::array<float, 8> weights;
+  TrilinearCorners(min, max, resolution, point, &probes, &weights);
+  for (size_t corner = 0; corner < 8; ++corner) {
+    if (weights[corner] == 0.0f) continue;
+    const float* c = &coefficients[probes[corner] * 27];
+    for (size_t k = 0; k < 27; ++k) out[k] += weights[corner] * c[k];
+  }
+  return out;
+}
+
+void IrradianceVolume::Snapshot(Sh9Snapshot* out) const {
+  out->min = gather_.min, out->max = gather_.max, out->resolution = gather_.resolution;
+  out->coefficients.assign(coefficients_.begin(), coefficients_.end());
+}
+
+void IrradianceVolume::Corners(const glm::vec3& point, std::array<size_t, 8>* probes, std::array<float, 8>* weights) const {
+  TrilinearCorners(gather_.min, gather_.max, gather_.resolution, point, probes, weights);
 }
 
 glm::vec3 IrradianceVolume::Integrate(const glm::vec3& point, const Sh9Basis& y) const {

@@ -25,6 +25,25 @@
 
 namespace daylit::sh {
 
+// The eight grid points around `point` (clamped into the box [min, max]) of a grid of
+// `resolution` points spanning it (point (i, j, k) at min + (max − min) · (i, j, k)/(n − 1)),
+// as indices (k·ny + j)·nx + i, and their trilinear weights, summing to 1.
+void TrilinearCorners(const glm::vec3& min, const glm::vec3& max, const glm::ivec3& resolution, const glm::vec3& point,
+                      std::array<size_t, 8>* indices, std::array<float, 8>* weights);
+
+// A copy of a volume's coefficients at one moment (IrradianceVolume::Snapshot), for a reader on
+// another thread (daylit's lighting server): the same layout and interpolation.
+struct Sh9Snapshot {
+  glm::vec3 min{0.0f}, max{0.0f};
+  glm::ivec3 resolution{0};
+  std::vector<float> coefficients;  // IrradianceVolume::coefficients()' layout
+
+  bool empty() const { return coefficients.empty(); }
+  // The 9 RGB irradiance coefficients at `point` (trilinear, clamped into the box), coefficient
+  // c's R, G, B at [3c], [3c + 1], [3c + 2].
+  std::array<float, 27> At(const glm::vec3& point) const;
+};
+
 class IrradianceVolume {
  public:
   // `inside[p]` marks probes inside the model (bake::ProbesInsideModel): they take the mean of their
@@ -54,6 +73,8 @@ class IrradianceVolume {
   glm::vec3 ProbeIrradiance(int i, int j, int k, const glm::vec3& normal) const;
 
   const std::vector<float>& coefficients() const { return coefficients_; }
+  // The coefficients and the grid into `out` (its storage reused).
+  void Snapshot(Sh9Snapshot* out) const;
   const GatherTables& gather() const { return gather_; }
   size_t InsideCount() const;
 

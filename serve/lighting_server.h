@@ -1,0 +1,89 @@
+// daylit's lighting server (replay/live --serve [HOST:]PORT): while the pipeline runs, other
+// programs read each frame's lighting over HTTP on loopback (or any host given):
+//   GET /lighting[?at=x,y,z]  the latest frame's message (serve/lighting_message.h); 503 before
+//                             the first frame
+//   GET /stream               Server-Sent Events: one `data:` message per frame, in order
+//   GET /scene                what a renderer needs to place the camera (intrinsics, pose, up,
+//                             north, units)
+// The pipeline only hands messages over (a copy under a lock); the network is the server's
+// threads'. A client that falls behind loses its oldest messages (counted, and said in the
+// stream as an `event: dropped`); one that takes nothing for a while, or cannot be written to
+// for two seconds, is closed. Many clients at once, each on its own thread.
+#pragma once
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <list>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "serve/lighting_message.h"
+
+namespace httplib {
+class Server;
+}
+
+namespace daylit::serve {
+
+struct ServerOptions {
+  std::string host = "127.0.0.1";
+  int port = 0;                   // 0: any free port (tests)
+  size_t queued_per_client = 64;  // messages a stream client may fall behind before losing them
+  int idle_close_s = 10;          // a stream client whose queue stayed full this long is closed
+  int max_clients = 32;           // stream clients at once; more are answered 503
+};
+
+// "[HOST:]PORT" → host and port; InputError naming `where` otherwise.
+ServerOptions ParseHostPort(const std::string& text, const char* where);
+
+struct ServerStats {
+  uint64_t published = 0;      // messages handed over
+  uint64_t dropped = 0;        // messages stream clients lost by falling behind
+  uint64_t clients_seen = 0;   // stream clients that connected
+  uint64_t clients_closed = 0; // closed by the server (behind, or not writable)
+};
+
+class LightingServer {
+ public:
+  // Binds and starts listening; throws InputError naming HOST:PORT if it cannot (taken, not
+  // allowed, no such address) before any of the pipeline's work.
+  LightingServer(const ServerOptions& options, std::string scene_json);
+  ~LightingServer();  // stops: every connection closed, threads joined
+  LightingServer(const LightingServer&) = delete;
+  LightingServer& operator=(const LightingServer&) = delete;
+
+  int port() const { return port_; }
+  // The frame's lighting to /lighting and every stream client. Never blocks on the network.
+  void Publish(std::shared_ptr<const FrameLighting> lighting);
+  ServerStats stats() const;
+
+ private:
+  struct Client {
+    std::deque<std::shared_ptr<const std::string>> queue;
+    uint64_t dropped_unsaid = 0;  // lost since the last `event: dropped`
+    std::optional<std::chrono::steady_clock::time_point> full_since;  // behind since, until it takes
+    bool closed = false;
+  };
+  void Stop();
+
+  ServerOptions options_;
+  std::string scene_json_;
+  std::unique_ptr<httplib::Server> server_;
+  std::thread listener_;
+  int port_ = 0;
+
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::shared_ptr<const FrameLighting> latest_;
+  std::shared_ptr<const std::string> latest_json_;
+  std::list<std::shared_ptr<Client>> clients_;
+  ServerStats stats_;
+  bool stopping_ = false;
+};
+
+}  // namespace daylit::serve
