@@ -55,6 +55,8 @@ class FrameRenderer {
   // The frame linearised in radiance units, as Render starts from (for comparisons).
   void Linearize(const capture::Frame& frame, std::vector<float>* linear) const;
   const composite::ObjectShadows& shadows() const { return shadows_; }
+  // The irradiance volume as the last Render left it (sun excluded); null without one.
+  const sh::IrradianceVolume* volume() const { return volume_.get(); }
   // With --lighting lights:N, the lights (null otherwise).
   const lightfit::EnvLights* env_lights() const { return env_lights_.get(); }
   int width() const { return compositor_.width(); }

@@ -18,6 +18,7 @@
 #include <glm/gtc/constants.hpp>
 #include <nlohmann/json.hpp>
 
+#include "base/csv.h"
 #include "base/error.h"
 
 namespace daylit::serve {
@@ -108,6 +109,11 @@ TEST(LightingServerTest, LightingIs503BeforeTheFirstFrameThenTheLatestWithWebXrN
   const glm::vec3 sun = Frame(0)->sun_scene;
   EXPECT_NEAR(j["primaryLightDirection"]["y"].get<double>(), sun.y, 1e-6);
   EXPECT_TRUE(j["sphericalHarmonicsCoefficients"].is_null());  // no volume
+  // Every field the published schema requires is there.
+  const nlohmann::json schema = nlohmann::json::parse(ReadTextFile(DAYLIT_SOURCE_DIR "/docs/lighting.schema.json"));
+  EXPECT_EQ(schema["properties"]["version"]["const"], kLightingSchema);
+  for (const auto& key : schema["required"]) EXPECT_TRUE(j.contains(key.get<std::string>())) << key;
+  EXPECT_EQ(j.size(), schema["properties"].size());
   res = client.Get("/scene");
   ASSERT_TRUE(res);
   EXPECT_EQ(res->body, R"({"units": "m"})");

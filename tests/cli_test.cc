@@ -1,7 +1,10 @@
 // The `daylit` binary as a user runs it: exit codes, one-line errors on stderr, results on stdout.
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
 #include <fcntl.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -17,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -1002,6 +1006,42 @@ TEST(CliTest, CalibrateSceneFitsNorthOnOneBurstAndWritesAResolvableScene) {
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("--what"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "x.json"));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace daylit
+
+namespace daylit {
+namespace {
+
+// --serve takes its port before any work: a port in use, or text that is not [HOST:]PORT, exits 2
+// with one line naming it, and nothing is written (no bake, no video).
+TEST(CliTest, ServeOnAPortInUseOrNotAPortExitsWithCode2BeforeAnyWork) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(bind(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)), 0);
+  ASSERT_EQ(listen(fd, 1), 0);
+  socklen_t length = sizeof(addr);
+  ASSERT_EQ(getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &length), 0);
+  const int port = ntohs(addr.sin_port);
+  const fs::path dir = fs::temp_directory_path() / fmt::format("daylit_serve_{}", ::getpid());
+  fs::create_directories(dir);
+  const std::string common = " --cache " + (dir / "cache").string() + " --out " + (dir / "r.mp4").string();
+  const CliRun taken = Daylit(fmt::format("replay {} --serve {}{}", kRecording, port, common));
+  EXPECT_EQ(taken.exit_code, 2) << taken.err;
+  EXPECT_NE(taken.err.find(fmt::format("--serve: cannot listen on 127.0.0.1:{}: Address already in use", port)),
+            std::string::npos)
+      << taken.err;
+  const CliRun bad = Daylit("replay " + kRecording + " --serve localhost:http" + common);
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--serve: 'localhost:http' is not [HOST:]PORT"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "cache"));
+  EXPECT_FALSE(fs::exists(dir / "r.mp4"));
+  close(fd);
   fs::remove_all(dir);
 }
 

@@ -31,6 +31,7 @@
 #include "render/gl_window.h"
 #include "report/plot.h"
 #include "scene/scene.h"
+#include "serve/lighting_server.h"
 
 namespace daylit::app {
 namespace {
@@ -48,6 +49,59 @@ struct ReplayOptions {
   std::string relight_at;  // the time slider's start, HH:MM UTC
   std::string lighting = "volume";
   double calibrate_s = 0.0;  // live: fit north on this many seconds of the camera first
+  std::string serve;         // [HOST:]PORT of the lighting server; empty: none
+};
+
+// What GET /scene tells a renderer that places its own camera (docs/serve.md).
+std::string SceneJson(const scene::Scene& scene) {
+  const scene::CameraIntrinsics& k = scene.intrinsics;
+  nlohmann::json rotation = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r) {
+    rotation.push_back({scene.cam_from_world.rotation[0][r], scene.cam_from_world.rotation[1][r], scene.cam_from_world.rotation[2][r]});
+  }
+  const glm::dvec3 t = scene.cam_from_world.translation, center = scene.Camera().CenterInWorld();
+  nlohmann::json j = {
+      {"version", serve::kLightingSchema},
+      {"name", scene.name},
+      {"units", "m"},
+      {"up", {0, 0, 1}},
+      {"north_azimuth_deg", scene.north_azimuth_deg},
+      {"camera",
+       {{"convention", "OpenCV: x right, y down, z forward; x_cam = R x_world + t"},
+        {"width", k.width}, {"height", k.height}, {"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy},
+        {"world_to_camera", {{"rotation", rotation}, {"translation", {t.x, t.y, t.z}}}},
+        {"center", {center.x, center.y, center.z}}}},
+  };
+  if (scene.volume) {
+    j["volume"] = {{"min", {scene.volume->min.x, scene.volume->min.y, scene.volume->min.z}},
+                   {"max", {scene.volume->max.x, scene.volume->max.y, scene.volume->max.z}}};
+  }
+  return j.dump();
+}
+
+// Each frame's lighting to the lighting server: the estimate, the sun in scene and camera
+// coordinates, and the irradiance volume as the renderer left it (a copy of its coefficients).
+class ServeSink : public pipeline::FrameSink {
+ public:
+  ServeSink(const scene::Scene& scene, const render::FrameRenderer& renderer, serve::LightingServer* server)
+      : scene_(scene), renderer_(renderer), server_(server) {}
+  void Consume(const pipeline::PipelineFrame& f) override {
+    auto l = std::make_shared<serve::FrameLighting>();
+    l->row = f.light.row;
+    l->overcast_share = f.light.overcast_share;
+    l->sun_scene = f.sun.dir_in_scene;
+    l->sun_camera = glm::vec3(scene_.cam_from_world.rotation * glm::dvec3(f.sun.dir_in_scene));
+    if (const sh::IrradianceVolume* volume = renderer_.volume()) {
+      volume->Snapshot(&l->volume);
+      l->volume_center = 0.5f * (l->volume.min + l->volume.max);
+    }
+    server_->Publish(std::move(l));
+  }
+
+ private:
+  const scene::Scene& scene_;
+  const render::FrameRenderer& renderer_;
+  serve::LightingServer* server_;
 };
 
 // daylit live --calibrate: the camera's first `seconds` through the estimator, north fitted on
@@ -143,6 +197,9 @@ void RunReplay(const ReplayOptions& o) {
   if (!o.screenshot.empty() && !o.window) ThrowInputError("--screenshot: needs --window");
   if (!o.screenshot.empty() && fs::path(o.screenshot).extension() != ".png") ThrowInputError("--screenshot: {} must end in .png", o.screenshot);
   if (!o.relight_at.empty() && !o.window) ThrowInputError("--relight-at: needs --window (daylit relight writes a relit video)");
+  // The port is taken before any work, so that a port in use fails at once.
+  std::optional<serve::LightingServer> server;
+  if (!o.serve.empty()) server.emplace(serve::ParseHostPort(o.serve, "--serve"), SceneJson(scene));
   render::FrameRendererOptions render_options;
   render_options.lights = render::ParseLighting(o.lighting, "--lighting");
   render::TimeSlider slider(scene.location.longitude_deg);
@@ -183,6 +240,8 @@ void RunReplay(const ReplayOptions& o) {
   pipeline::LightingPipeline lighting(scene, baked, caster, options);
   lighting.SetStage(&composite);
   lighting.AddSink(&fidelity);
+  std::optional<ServeSink> serving;
+  if (server) lighting.AddSink(&serving.emplace(scene, renderer, &*server));
   if (window) lighting.AddSink(&shown.emplace(scene, window.get(), &slider));
   if (video) lighting.SetVideo(&video->writer());
   const pipeline::PipelineRun run = lighting.Run(std::move(source));
@@ -211,6 +270,9 @@ void AddPipelineOptions(CLI::App* cmd, const std::shared_ptr<ReplayOptions>& opt
   cmd->add_option("--relight-at", options->relight_at,
                   "With --window: start the time slider at this UTC time of day (HH:MM); the frames are shown "
                   "relit to the sun of that time on their own day (daylit relight's ratio), objects included");
+  cmd->add_option("--serve", options->serve,
+                  "Serve each frame's lighting over HTTP while it runs, on [HOST:]PORT (host 127.0.0.1 unless given): "
+                  "GET /lighting, /stream (Server-Sent Events), /scene (docs/serve.md)");
   cmd->callback([options, out] {
     options->out_given = out->count() > 0;
     RunReplay(*options);
