@@ -1,7 +1,5 @@
 #include "serve/lighting_message.h"
 
-#include <glm/gtc/constants.hpp>
-
 #include "base/utc_time.h"
 
 namespace daylit::serve {
@@ -12,11 +10,8 @@ nlohmann::json Xyz(const glm::dvec3& v) { return {{"x", v.x}, {"y", v.y}, {"z", 
 }  // namespace
 
 std::array<float, 27> RadianceCoefficients(const std::array<float, 27>& irradiance) {
-  // Ramamoorthi & Hanrahan's clamped-cosine factors per band (sh9.h): π, 2π/3, π/4.
-  constexpr float kPi = glm::pi<float>();
-  constexpr std::array<float, 9> kA = {kPi, 2 * kPi / 3, 2 * kPi / 3, 2 * kPi / 3, kPi / 4, kPi / 4, kPi / 4, kPi / 4, kPi / 4};
   std::array<float, 27> out{};
-  for (size_t k = 0; k < 27; ++k) out[k] = irradiance[k] / kA[k / 3];
+  for (size_t k = 0; k < 27; ++k) out[k] = static_cast<float>(irradiance[k] / sh::kCosineLobe[k / 3]);
   return out;
 }
 
@@ -41,7 +36,7 @@ nlohmann::json LightingJson(const FrameLighting& l, const std::optional<glm::vec
     j["sphericalHarmonicsCoefficients"] = nullptr;
     j["sphericalHarmonicsAt"] = nullptr;
   } else {
-    const glm::vec3 point = at.value_or(l.volume_center);
+    const glm::vec3 point = at.value_or(0.5f * (l.volume.min + l.volume.max));
     const std::array<float, 27> c = RadianceCoefficients(l.volume.At(point));
     j["sphericalHarmonicsCoefficients"] = c;
     j["sphericalHarmonicsAt"] = {point.x, point.y, point.z};

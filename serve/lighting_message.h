@@ -14,6 +14,7 @@
 
 #include "estimation/frame_estimator.h"
 #include "sh/irradiance_volume.h"
+#include "sh/sh9.h"
 
 namespace daylit::serve {
 
@@ -26,10 +27,9 @@ struct FrameLighting {
   glm::vec3 sun_camera{0.0f};      // the same in the camera's (OpenCV: x right, y down, z forward)
   double overcast_share = 0.0;     // E_overcast / E_sky
   sh::Sh9Snapshot volume;          // the irradiance volume (sun excluded); empty without one
-  glm::vec3 volume_center{0.0f};   // the default point of sphericalHarmonicsCoefficients
 };
 
-// The message: sphericalHarmonicsCoefficients at `at` (default the volume's centre), or null
+// The message: sphericalHarmonicsCoefficients at `at` (default the volume box's centre), or null
 // without a volume.
 nlohmann::json LightingJson(const FrameLighting& lighting, const std::optional<glm::vec3>& at = std::nullopt);
 

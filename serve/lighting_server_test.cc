@@ -128,7 +128,6 @@ TEST(LightingServerTest, ShCoefficientsAreTheVolumesRadianceCoefficientsAtThePoi
   l->volume.coefficients.assign(2 * 27, 0.0f);
   l->volume.coefficients[0] = 1.0f, l->volume.coefficients[27] = 3.0f;
   l->volume.coefficients[3 * 2 + 1] = 2.0f;  // coefficient 2 (l = 1), green, at the first probe
-  l->volume_center = glm::vec3(1.0f, 0.5f, 0.5f);
   server.Publish(l);
   httplib::Client client("127.0.0.1", server.port());
   auto res = client.Get("/lighting");

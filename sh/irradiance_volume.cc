@@ -16,11 +16,6 @@ namespace {
 
 constexpr int kCoefficients = 9;
 
-// Â_l of the clamped-cosine convolution for the band of coefficient c (sh9.h's order).
-double CosineLobe(int c) {
-  const double pi = glm::pi<double>();
-  return c == 0 ? pi : c < 4 ? 2.0 * pi / 3.0 : pi / 4.0;
-}
 
 }  // namespace
 
@@ -33,7 +28,7 @@ IrradianceVolume::IrradianceVolume(const sh::GatherTables& gather, std::vector<u
   for (size_t d = 0; d < dirs; ++d) {
     const Sh9Basis y = EvalSh9(glm::dvec3(gather.directions[d]));
     for (int c = 0; c < kCoefficients; ++c) {
-      basis_[static_cast<size_t>(c) * dirs + d] = static_cast<float>(CosineLobe(c) * y[static_cast<size_t>(c)] * weight);
+      basis_[static_cast<size_t>(c) * dirs + d] = static_cast<float>(kCosineLobe[static_cast<size_t>(c)] * y[static_cast<size_t>(c)] * weight);
     }
   }
   coefficients_.assign(gather.ProbeCount() * kCoefficients * 3, 0.0f);

@@ -9,11 +9,6 @@
 namespace daylit::sh {
 namespace {
 
-// Clamped-cosine convolution per band: Â_0, Â_1 (×3), Â_2 (×5).
-constexpr double kPi = glm::pi<double>();
-constexpr std::array<double, 9> kCosineLobe = {kPi,           2.0 * kPi / 3.0, 2.0 * kPi / 3.0,
-                                               2.0 * kPi / 3.0, kPi / 4.0,     kPi / 4.0,
-                                               kPi / 4.0,     kPi / 4.0,       kPi / 4.0};
 
 }  // namespace
 

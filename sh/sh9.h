@@ -12,10 +12,19 @@
 #include <array>
 
 #include <glm/glm.hpp>
+#include <glm/gtc/constants.hpp>
 
 namespace daylit::sh {
 
 using Sh9Basis = std::array<double, 9>;
+
+// Â_l of the clamped-cosine convolution for each coefficient (sh9.h's order): Â_0, Â_1 (×3),
+// Â_2 (×5). Irradiance coefficients are radiance coefficients times these.
+inline constexpr Sh9Basis kCosineLobe = {glm::pi<double>(),           2.0 * glm::pi<double>() / 3.0,
+                                         2.0 * glm::pi<double>() / 3.0, 2.0 * glm::pi<double>() / 3.0,
+                                         glm::pi<double>() / 4.0,     glm::pi<double>() / 4.0,
+                                         glm::pi<double>() / 4.0,     glm::pi<double>() / 4.0,
+                                         glm::pi<double>() / 4.0};
 
 // RGB radiance projected on the 9 basis functions.
 struct ShRgb9 {

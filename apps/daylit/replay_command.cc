@@ -91,10 +91,7 @@ class ServeSink : public pipeline::FrameSink {
     l->overcast_share = f.light.overcast_share;
     l->sun_scene = f.sun.dir_in_scene;
     l->sun_camera = glm::vec3(scene_.cam_from_world.rotation * glm::dvec3(f.sun.dir_in_scene));
-    if (const sh::IrradianceVolume* volume = renderer_.volume()) {
-      volume->Snapshot(&l->volume);
-      l->volume_center = 0.5f * (l->volume.min + l->volume.max);
-    }
+    if (const sh::IrradianceVolume* volume = renderer_.volume()) volume->Snapshot(&l->volume);
     server_->Publish(std::move(l));
   }
 
