@@ -19,7 +19,8 @@ struct Frame {
   int index = 0;         // frames.csv's frame number; a live source counts from 0
   UtcTime utc;           // when the frame was exposed
   double exposure = 1.0;  // k: linear pixel = k · radiance
-  cv::Mat rgb;           // CV_32FC3, R, G, B
+  cv::Mat rgb;           // CV_32FC3, R, G, B; each frame gets its own buffer, never written again
+                         // once handed out, so a reader may keep it (daylit's lighting server)
   bool linear = false;   // true: linear light (EXR); false: encoded by the camera response
 };
 

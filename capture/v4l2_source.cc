@@ -198,6 +198,7 @@ class V4l2Source final : public FrameSource {
     frame->utc = KernelTimestampToUtc(buffer.timestamp, monotonic, utc_now);
     frame->exposure = options_.exposure;
     frame->linear = false;
+    frame->rgb.release();  // its own buffer: the last frame's may still be read (Frame::rgb)
     const bool ok = Decode(static_cast<const uint8_t*>(mapped_[buffer.index].first), buffer.bytesused, &frame->rgb);
     Ioctl(fd_, VIDIOC_QBUF, &buffer);
     if (!ok) {

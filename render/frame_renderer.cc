@@ -82,6 +82,7 @@ void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcas
     // combines them.
     if (relighter_.SetSun(sun_dir)) {
       relighter_.Basis(&basis_);
+      ++basis_generation_;
       shadows_.SetEnvBasis(basis_);
       if (env_lights_) env_lights_->SetBasis(basis_);
       const std::vector<glm::vec3>* maps[3] = {&basis_.sun, &basis_.clear, &basis_.overcast};

@@ -57,6 +57,12 @@ class FrameRenderer {
   const composite::ObjectShadows& shadows() const { return shadows_; }
   // The irradiance volume as the last Render left it (sun excluded); null without one.
   const sh::IrradianceVolume* volume() const { return volume_.get(); }
+  // The relit map's parts for the current sun (EnvRelighter::Basis), and how many times they
+  // were made: a reader copies them again only when that count moved. Empty before the first
+  // Render with a volume or lights.
+  const relight::EnvBasis& env_basis() const { return basis_; }
+  int env_basis_generation() const { return basis_generation_; }
+  const relight::EnvRelighter& relighter() const { return relighter_; }
   // With --lighting lights:N, the lights (null otherwise).
   const lightfit::EnvLights* env_lights() const { return env_lights_.get(); }
   int width() const { return compositor_.width(); }
@@ -76,6 +82,7 @@ class FrameRenderer {
   Compositor compositor_;
   capture::Linearizer linearizer_;
   relight::EnvBasis basis_;
+  int basis_generation_ = 0;
   std::array<std::vector<float>, 3> volume_parts_;  // the volume per unit E_sun, E_clear, E_overcast
   std::unique_ptr<lightfit::EnvLights> env_lights_;  // --lighting lights:N
 };

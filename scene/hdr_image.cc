@@ -6,6 +6,7 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfStdIO.h>
 #include <half.h>
 
 #include <algorithm>
@@ -259,7 +260,10 @@ void CheckRadianceValues(const HdrImage& image, const std::string& name) {
   }
 }
 
-void WriteExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels) {
+namespace {
+
+// The channels written into `stream` (ZIP compressed); what Imf throws is left to the caller.
+void WriteExrTo(Imf::OStream& stream, int width, int height, const std::vector<ExrChannel>& channels) {
   const size_t count = static_cast<size_t>(width) * height;
   Imf::Header header(width, height);
   header.compression() = Imf::ZIP_COMPRESSION;
@@ -281,17 +285,30 @@ void WriteExr(const std::filesystem::path& path, int width, int height, const st
                                       sizeof(float), sizeof(float) * static_cast<size_t>(width)));
     }
   }
+  Imf::OutputFile file(stream, header);
+  file.setFrameBuffer(frame);
+  file.writePixels(height);
+}
+
+}  // namespace
+
+void WriteExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels) {
   const std::filesystem::path tmp = TemporarySibling(path);
   try {
-    Imf::OutputFile file(tmp.c_str(), header);
-    file.setFrameBuffer(frame);
-    file.writePixels(height);
+    Imf::StdOFStream stream(tmp.c_str());
+    WriteExrTo(stream, width, height, channels);
   } catch (const std::exception& e) {
     std::error_code ec;
     std::filesystem::remove(tmp, ec);
     ThrowInputError("{}: cannot write OpenEXR ({})", path.string(), e.what());
   }
   CommitTemporary(tmp, path);
+}
+
+std::string EncodeExr(int width, int height, const std::vector<ExrChannel>& channels) {
+  Imf::StdOSStream stream;
+  WriteExrTo(stream, width, height, channels);
+  return stream.str();
 }
 
 void WriteRgbExr(const std::filesystem::path& path, int width, int height, const float* rgb) {

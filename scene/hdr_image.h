@@ -63,6 +63,9 @@ struct ExrChannel {
 // Writes a multi-channel OpenEXR (ZIP compressed) to a temporary file and renames it to `path`.
 void WriteExr(const std::filesystem::path& path, int width, int height, const std::vector<ExrChannel>& channels);
 
+// The same file's bytes, in memory (daylit's lighting server's GET /envmap).
+std::string EncodeExr(int width, int height, const std::vector<ExrChannel>& channels);
+
 // Writes interleaved RGB floats (width·height·3, row-major from the top) as a float R, G, B
 // OpenEXR, through WriteExr.
 void WriteRgbExr(const std::filesystem::path& path, int width, int height, const float* rgb);

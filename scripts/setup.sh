@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs every Debian package daylit uses (build, tests, benchmarks, headless GL,
-# video). Idempotent and quiet: when everything is already installed it only checks.
+# video, Chromium for the browser viewer's test), then the viewer's npm packages (three.js and
+# the test's playwright-core and pngjs, pinned in web/package-lock.json) into web/node_modules.
+# Idempotent and quiet: when everything is already installed it only checks.
 # Run as root (or with sudo available) on Debian bookworm.
 set -euo pipefail
 
@@ -11,7 +13,7 @@ packages=(
   libgl1-mesa-dri libgbm-dev libopenexr-dev libimath-dev libembree-dev libtbb-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
   libcpp-httplib-dev libspdlog-dev libfmt-dev libtinyobjloader-dev libtinygltf-dev libstb-dev liberfa-dev
-  ffmpeg xvfb xauth clang libclang-rt-14-dev
+  ffmpeg xvfb xauth clang libclang-rt-14-dev chromium
 )
 
 missing=()
@@ -20,7 +22,38 @@ for p in "${packages[@]}"; do
     missing+=("$p")
   fi
 done
+# Node.js ≥ 20 runs the npm registry's packages (playwright-core needs it); Debian's own is 18,
+# so it is only installed where there is none, and checked below.
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then missing+=(nodejs npm); fi
+
+# The viewer's packages, exactly as web/package-lock.json pins them, once per change of it.
+install_web() {
+  local web stamp
+  web="$(cd "$(dirname "$0")/.." && pwd)/web"
+  stamp="$web/node_modules/.daylit-lock-sha256"
+  local want
+  want=$(sha256sum "$web/package-lock.json" | cut -d' ' -f1)
+  if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$want" ]; then return 0; fi
+  local major
+  major=$(node -p 'process.versions.node.split(".")[0]' 2>/dev/null || echo 0)
+  if [ "$major" -lt 20 ]; then
+    echo "setup: Node.js $(node --version 2>/dev/null || echo none) is too old for the viewer's test (playwright-core needs 20 or later)" >&2
+    exit 1
+  fi
+  echo "setup: installing the viewer's npm packages (web/package-lock.json)..." >&2
+  local log
+  log=$(mktemp /tmp/daylit-npm.XXXXXX.log)
+  if ! (cd "$web" && npm ci --no-audit --no-fund) >"$log" 2>&1; then
+    tail -n 30 "$log" >&2
+    echo "setup: npm ci failed in $web; full log in $log" >&2
+    exit 1
+  fi
+  rm -f "$log"
+  echo "$want" >"$stamp"
+}
+
 if [ ${#missing[@]} -eq 0 ]; then
+  install_web
   exit 0
 fi
 
@@ -43,3 +76,4 @@ if ! { "${sudo_cmd[@]}" apt-get update -q &&
 fi
 rm -f "$log"
 echo "setup: done" >&2
+install_web

@@ -2,7 +2,9 @@
 # Sets up, builds and runs the whole test suite (ctest). --sanitize: the same under
 # AddressSanitizer + UndefinedBehaviorSanitizer, less the tests labelled `accuracy` (whole
 # recordings against the path tracer, which the plain pass runs; under the sanitizers they cost
-# most of CI's time and reach no code the other tests do not).
+# most of CI's time and reach no code the other tests do not) and `browser` (the viewer in
+# Chromium: its JavaScript gains nothing from them; the server's C++ is tested under them by
+# serve/lighting_server_test).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir=$(bash scripts/build.sh "$@" | tail -n 1)
@@ -11,5 +13,5 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export MESA_SHADER_CACHE_DIR="${MESA_SHADER_CACHE_DIR:-$PWD/$build_dir/mesa-cache}"
 cd "$build_dir"
 filter=()
-if [ "${1:-}" = "--sanitize" ]; then filter=(-LE accuracy); fi
+if [ "${1:-}" = "--sanitize" ]; then filter=(-LE 'accuracy|browser'); fi
 ctest -j "$(nproc)" --output-on-failure --timeout 600 "${filter[@]}"

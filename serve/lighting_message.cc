@@ -1,13 +1,62 @@
 #include "serve/lighting_message.h"
 
+#include <opencv2/imgproc.hpp>
+
 #include "base/utc_time.h"
+#include "scene/hdr_image.h"
 
 namespace daylit::serve {
 namespace {
 
 nlohmann::json Xyz(const glm::dvec3& v) { return {{"x", v.x}, {"y", v.y}, {"z", v.z}}; }
 
+std::vector<glm::vec3> Shrink(int width, int height, const std::vector<glm::vec3>& map, int out_width, int out_height) {
+  if (out_width == width && out_height == height) return map;
+  const cv::Mat in(height, width, CV_32FC3, const_cast<glm::vec3*>(map.data()));
+  std::vector<glm::vec3> out(static_cast<size_t>(out_width) * static_cast<size_t>(out_height));
+  cv::Mat shrunk(out_height, out_width, CV_32FC3, out.data());
+  cv::resize(in, shrunk, shrunk.size(), 0.0, 0.0, cv::INTER_AREA);  // each texel the mean of those it covers
+  return out;
+}
+
 }  // namespace
+
+std::shared_ptr<const EnvMapParts> ShrinkEnvMapParts(int width, int height, const std::vector<glm::vec3>& sun,
+                                                     const std::vector<glm::vec3>& clear,
+                                                     const std::vector<glm::vec3>& overcast) {
+  const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
+  if (width <= 0 || height <= 0 || sun.size() < n || clear.size() < n || overcast.size() < n) return nullptr;
+  auto parts = std::make_shared<EnvMapParts>();
+  parts->width = std::min(width, kEnvMapWidth);
+  parts->height = std::min(height, kEnvMapHeight);
+  // The stacked bases (relight::EnvBasis) carry a sky layer after the map: only the map is shrunk.
+  const auto map = [n](const std::vector<glm::vec3>& v) { return std::vector<glm::vec3>(v.begin(), v.begin() + static_cast<long>(n)); };
+  parts->sun = Shrink(width, height, map(sun), parts->width, parts->height);
+  parts->clear = Shrink(width, height, map(clear), parts->width, parts->height);
+  parts->overcast = Shrink(width, height, map(overcast), parts->width, parts->height);
+  return parts;
+}
+
+std::vector<float> RelitEnvMap(const EnvMapParts& parts, const estimation::SunSky& light, double overcast_share) {
+  const estimation::LightParts e = estimation::SplitLight(light, overcast_share);
+  std::vector<float> rgb(parts.sun.size() * 3);
+  for (size_t i = 0; i < parts.sun.size(); ++i) {
+    const glm::vec3 l = e.sun * parts.sun[i] + e.clear * parts.clear[i] + e.overcast * parts.overcast[i];
+    rgb[3 * i] = l.r, rgb[3 * i + 1] = l.g, rgb[3 * i + 2] = l.b;
+  }
+  return rgb;
+}
+
+std::string EnvMapExr(const EnvMapParts& parts, const estimation::SunSky& light, double overcast_share) {
+  const std::vector<float> rgb = RelitEnvMap(parts, light, overcast_share);
+  const size_t n = parts.sun.size();
+  std::vector<float> r(n), g(n), b(n);
+  for (size_t i = 0; i < n; ++i) r[i] = rgb[3 * i], g[i] = rgb[3 * i + 1], b[i] = rgb[3 * i + 2];
+  return scene::EncodeExr(parts.width, parts.height,
+                          {{"R", scene::ExrPixelType::kHalf, r.data(), nullptr},
+                           {"G", scene::ExrPixelType::kHalf, g.data(), nullptr},
+                           {"B", scene::ExrPixelType::kHalf, b.data(), nullptr}});
+}
 
 std::array<float, 27> RadianceCoefficients(const std::array<float, 27>& irradiance) {
   std::array<float, 27> out{};
@@ -24,6 +73,7 @@ nlohmann::json LightingJson(const FrameLighting& l, const std::optional<glm::vec
       {"primaryLightDirection", Xyz(l.sun_scene)},
       {"primaryLightDirectionCamera", Xyz(l.sun_camera)},
       {"primaryLightIntensity", Xyz(r.light.sun_rgb)},
+      {"exposure", l.exposure},
       {"skyIrradiance", Xyz(r.light.sky_rgb)},
       {"overcastShare", l.overcast_share},
       {"sunElevationDeg", r.sun_elevation_deg},

@@ -8,8 +8,11 @@
 #include <chrono>
 #include <cstring>
 
+#include <filesystem>
+
 #include <fmt/format.h>
 #include <httplib.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "base/error.h"
 #include "base/log.h"
@@ -44,6 +47,13 @@ std::string WhyCannotBind(const std::string& host, int port) {
 
 void AllowAnyOrigin(httplib::Response* res) { res->set_header("Access-Control-Allow-Origin", "*"); }
 
+void NoFrameYet(httplib::Response* res, const char* what) {
+  res->status = 503;
+  res->set_content(fmt::format(R"({{"error": "no {} yet"}})", what), "application/json");
+}
+
+constexpr const char* kVideoBoundary = "daylitframe";
+
 }  // namespace
 
 ServerOptions ParseHostPort(const std::string& text, const char* where) {
@@ -62,8 +72,8 @@ ServerOptions ParseHostPort(const std::string& text, const char* where) {
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used == 0 || used != port.size() || value < 1 || value > 65535) {
-    ThrowInputError("{}: '{}' is not [HOST:]PORT with a port in 1..65535", where, text);
+  if (used == 0 || used != port.size() || value < 0 || value > 65535) {
+    ThrowInputError("{}: '{}' is not [HOST:]PORT with a port in 0..65535 (0: any free one)", where, text);
   }
   o.port = value;
   return o;
@@ -86,8 +96,7 @@ LightingServer::LightingServer(const ServerOptions& options, std::string scene_j
       latest = latest_, json = latest_json_;
     }
     if (latest == nullptr) {
-      res.status = 503;
-      res.set_content(R"({"error": "no frame yet"})", "application/json");
+      NoFrameYet(&res, "frame");
       return;
     }
     if (!req.has_param("at")) {
@@ -117,11 +126,7 @@ LightingServer::LightingServer(const ServerOptions& options, std::string scene_j
     auto client = std::make_shared<Client>();
     {
       const std::lock_guard<std::mutex> lock(mutex_);
-      if (stopping_ || clients_.size() >= static_cast<size_t>(options_.max_clients)) {
-        res.status = 503;
-        res.set_content(fmt::format(R"({{"error": "{} stream clients already"}})", clients_.size()), "application/json");
-        return;
-      }
+      if (!AdmitClient(&res)) return;
       if (latest_json_) client->queue.push_back(latest_json_);  // the newest frame first
       clients_.push_back(client);
       ++stats_.clients_seen;
@@ -161,8 +166,89 @@ LightingServer::LightingServer(const ServerOptions& options, std::string scene_j
         });
   });
 
-  s.Get("/", [](const httplib::Request&, httplib::Response& res) {
-    res.set_content("daylit lighting server: GET /lighting[?at=x,y,z], /stream (Server-Sent Events), /scene\n",
+  s.Get("/envmap", [this](const httplib::Request&, httplib::Response& res) {
+    AllowAnyOrigin(&res);
+    std::shared_ptr<const FrameLighting> latest;
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      latest = latest_;
+    }
+    if (latest == nullptr || latest->envmap == nullptr) return NoFrameYet(&res, "relit environment map");
+    res.set_header("X-Daylit-Frame", std::to_string(latest->row.frame));
+    res.set_content(EnvMapExr(*latest->envmap, latest->row.light, latest->overcast_share), "image/x-exr");
+  });
+
+  s.Get("/frame.jpg", [this](const httplib::Request&, httplib::Response& res) {
+    AllowAnyOrigin(&res);
+    std::shared_ptr<const FrameLighting> latest;
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      latest = latest_;
+    }
+    const std::shared_ptr<const std::string> jpeg = latest ? Jpeg(latest) : nullptr;
+    if (jpeg == nullptr) return NoFrameYet(&res, "camera frame");
+    res.set_header("X-Daylit-Frame", std::to_string(latest->row.frame));
+    res.set_header("Cache-Control", "no-store");
+    res.set_content(*jpeg, "image/jpeg");
+  });
+
+  s.Get("/video.mjpg", [this](const httplib::Request&, httplib::Response& res) {
+    AllowAnyOrigin(&res);
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (!AdmitClient(&res)) return;
+      ++video_clients_;
+      ++stats_.clients_seen;
+    }
+    res.set_header("Cache-Control", "no-cache");
+    auto sent = std::make_shared<std::shared_ptr<const FrameLighting>>();
+    res.set_chunked_content_provider(
+        std::string("multipart/x-mixed-replace; boundary=") + kVideoBoundary,
+        [this, sent](size_t, httplib::DataSink& sink) {
+          std::shared_ptr<const FrameLighting> next;
+          {
+            std::unique_lock<std::mutex> lock(mutex_);
+            // A new frame, or the same again after a second: a vanished viewer is found, and one
+            // that joins after the run's end still gets its picture.
+            changed_.wait_for(lock, std::chrono::seconds(1), [&] { return stopping_ || (latest_ && latest_ != *sent); });
+            if (stopping_) return false;
+            next = latest_;
+          }
+          if (next == nullptr) return true;
+          *sent = next;
+          const std::shared_ptr<const std::string> jpeg = Jpeg(next);
+          if (jpeg == nullptr) return true;
+          const std::string head = fmt::format("--{}\r\nContent-Type: image/jpeg\r\nContent-Length: {}\r\nX-Daylit-Frame: {}\r\n\r\n",
+                                               kVideoBoundary, jpeg->size(), next->row.frame);
+          if (!sink.write(head.data(), head.size()) || !sink.write(jpeg->data(), jpeg->size()) || !sink.write("\r\n", 2)) {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            if (!stopping_) ++stats_.clients_closed;
+            return false;
+          }
+          return true;
+        },
+        [this](bool) {
+          const std::lock_guard<std::mutex> lock(mutex_);
+          --video_clients_;
+        });
+  });
+
+  const std::filesystem::path web(options_.web_dir);
+  viewer_ = std::filesystem::is_regular_file(web / "viewer" / "index.html") &&
+            std::filesystem::is_regular_file(web / "node_modules" / "three" / "build" / "three.module.js") &&
+            s.set_mount_point("/viewer", (web / "viewer").string()) &&
+            s.set_mount_point("/three", (web / "node_modules" / "three" / "build").string()) &&
+            s.set_mount_point("/three-addons", (web / "node_modules" / "three" / "examples" / "jsm").string());
+  s.set_file_extension_and_mimetype_mapping("mjs", "text/javascript");
+  s.Get("/", [this, web](const httplib::Request&, httplib::Response& res) {
+    if (viewer_) {
+      res.set_redirect("/viewer/index.html");
+      return;
+    }
+    res.set_content(fmt::format("daylit lighting server: GET /lighting[?at=x,y,z], /stream (Server-Sent Events), /scene, "
+                                "/envmap, /frame.jpg, /video.mjpg.\nThe browser viewer is not installed ({} has no viewer/ "
+                                "or node_modules/three): run scripts/setup.sh.\n",
+                                web.string()),
                     "text/plain");
   });
 
@@ -187,7 +273,8 @@ LightingServer::LightingServer(const ServerOptions& options, std::string scene_j
     Stop();
     ThrowSystemError("--serve: the server on {} did not start", where);
   }
-  Log().info("serving the lighting on http://{}:{}/ (/lighting, /stream, /scene)", options_.host, port_);
+  Log().info("serving the lighting on http://{}:{}/ (/lighting, /stream, /scene, /envmap, /frame.jpg, /video.mjpg{})",
+             options_.host, port_, viewer_ ? "; the viewer at /" : "; no viewer: run scripts/setup.sh");
 }
 
 LightingServer::~LightingServer() { Stop(); }
@@ -227,6 +314,31 @@ void LightingServer::Publish(std::shared_ptr<const FrameLighting> lighting) {
     }
   }
   changed_.notify_all();
+}
+
+bool LightingServer::AdmitClient(httplib::Response* res) {
+  const size_t clients = clients_.size() + static_cast<size_t>(video_clients_);
+  if (!stopping_ && clients < static_cast<size_t>(options_.max_clients)) return true;
+  res->status = 503;
+  res->set_content(fmt::format(R"({{"error": "{} stream and video clients already"}})", clients), "application/json");
+  return false;
+}
+
+std::shared_ptr<const std::string> LightingServer::Jpeg(const std::shared_ptr<const FrameLighting>& lighting) {
+  if (lighting->image.empty()) return nullptr;
+  const std::lock_guard<std::mutex> lock(jpeg_mutex_);
+  if (jpeg_of_ != lighting) {
+    const cv::Mat& rgb = lighting->image;
+    const cv::Mat continuous = rgb.isContinuous() ? rgb : rgb.clone();
+    const cv::Mat bgr = capture::EncodeToBgr8(continuous.ptr<float>(), rgb.cols, rgb.rows, 1.0, lighting->linear_response.get());
+    std::vector<uchar> bytes;
+    cv::imencode(".jpg", bgr, bytes, {cv::IMWRITE_JPEG_QUALITY, options_.jpeg_quality});
+    jpeg_ = std::make_shared<const std::string>(bytes.begin(), bytes.end());
+    jpeg_of_ = lighting;
+    const std::lock_guard<std::mutex> stats_lock(mutex_);
+    ++stats_.jpegs;
+  }
+  return jpeg_;
 }
 
 ServerStats LightingServer::stats() const {

@@ -4,7 +4,12 @@
 //                             the first frame
 //   GET /stream               Server-Sent Events: one `data:` message per frame, in order
 //   GET /scene                what a renderer needs to place the camera (intrinsics, pose, up,
-//                             north, units)
+//                             north, units) and the virtual objects
+//   GET /envmap               the relit environment map, 128 × 64 half-float OpenEXR
+//   GET /frame.jpg            the latest camera frame as a JPEG
+//   GET /video.mjpg           the camera frames as MJPEG (multipart/x-mixed-replace), one per frame
+//   GET /                     the browser viewer (web/viewer: three.js, served from this server,
+//                             nothing fetched from elsewhere)
 // The pipeline only hands messages over (a copy under a lock); the network is the server's
 // threads'. A client that falls behind loses its oldest messages (counted, and said in the
 // stream as an `event: dropped`); one that takes nothing for a while, or cannot be written to
@@ -26,6 +31,7 @@
 
 namespace httplib {
 class Server;
+struct Response;
 }
 
 namespace daylit::serve {
@@ -35,7 +41,11 @@ struct ServerOptions {
   int port = 0;                   // 0: any free port (tests)
   size_t queued_per_client = 64;  // messages a stream client may fall behind before losing them
   int idle_close_s = 10;          // a stream client whose queue stayed full this long is closed
-  int max_clients = 32;           // stream clients at once; more are answered 503
+  int max_clients = 32;           // stream and video clients at once; more are answered 503
+  int jpeg_quality = 90;
+  // The viewer's files: viewer/ (index.html, viewer.js) and node_modules/three (scripts/setup.sh
+  // installs it from npm). Without them / says so and the rest is served as ever.
+  std::string web_dir = DAYLIT_WEB_DIR;
 };
 
 // "[HOST:]PORT" → host and port; InputError naming `where` otherwise.
@@ -46,6 +56,7 @@ struct ServerStats {
   uint64_t dropped = 0;        // messages stream clients lost by falling behind
   uint64_t clients_seen = 0;   // stream clients that connected
   uint64_t clients_closed = 0; // closed by the server (behind, or not writable)
+  uint64_t jpegs = 0;          // frames encoded as JPEG (once per frame, however many viewers)
 };
 
 class LightingServer {
@@ -70,6 +81,9 @@ class LightingServer {
     bool closed = false;
   };
   void Stop();
+  // `lighting`'s frame as a JPEG, encoded once and shared; null without an image.
+  std::shared_ptr<const std::string> Jpeg(const std::shared_ptr<const FrameLighting>& lighting);
+  bool AdmitClient(httplib::Response* res);  // under mutex_: false (503 said) when full
 
   ServerOptions options_;
   std::string scene_json_;
@@ -82,6 +96,11 @@ class LightingServer {
   std::shared_ptr<const FrameLighting> latest_;
   std::shared_ptr<const std::string> latest_json_;
   std::list<std::shared_ptr<Client>> clients_;
+  int video_clients_ = 0;
+  bool viewer_ = false;  // the viewer's files were found
+  std::mutex jpeg_mutex_;  // taken before mutex_ when both are held
+  std::shared_ptr<const FrameLighting> jpeg_of_;
+  std::shared_ptr<const std::string> jpeg_;
   ServerStats stats_;
   bool stopping_ = false;
 };

@@ -9,6 +9,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -18,8 +21,11 @@
 #include <glm/gtc/constants.hpp>
 #include <nlohmann/json.hpp>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "base/csv.h"
 #include "base/error.h"
+#include "scene/hdr_image.h"
 
 namespace daylit::serve {
 namespace {
@@ -79,7 +85,8 @@ TEST(ParseHostPortTest, PortAloneIsLoopbackAndBadTextNamesTheOption) {
   EXPECT_EQ(b.host, "0.0.0.0");
   EXPECT_EQ(b.port, 9000);
   EXPECT_EQ(ParseHostPort("[::1]:9001", "--serve").host, "::1");
-  for (const char* bad : {"abc", "70000", "0", ":80", "host:", "80x"}) {
+  EXPECT_EQ(ParseHostPort("0", "--serve").port, 0);  // any free port
+  for (const char* bad : {"abc", "70000", "-1", ":80", "host:", "80x"}) {
     try {
       ParseHostPort(bad, "--serve");
       ADD_FAILURE() << bad << " was taken";
@@ -205,6 +212,156 @@ TEST(LightingServerTest, APortTakenIsAnInputErrorNamingItAndWhy) {
     EXPECT_NE(what.find(fmt::format("127.0.0.1:{}", first.port())), std::string::npos) << what;
     EXPECT_NE(what.find("in use"), std::string::npos) << what;
   }
+}
+
+
+// A relit map's parts at twice the served size: each served texel is the mean of the 2 × 2 it
+// covers, and the EXR holds E_sun·sun + E_clear·clear + E_overcast·overcast in half floats.
+TEST(LightingServerTest, EnvMapIsTheRelitMapShrunkAsHalfFloatExr) {
+  const int w = 2 * kEnvMapWidth, h = 2 * kEnvMapHeight;
+  std::vector<glm::vec3> sun(2 * w * h), clear(2 * w * h), overcast(2 * w * h);  // stacked: map, then sky layer
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const size_t i = static_cast<size_t>(y) * w + x;
+      sun[i] = ((x + y) % 2 == 0) ? glm::vec3(2.0f, 0.0f, 1.0f) : glm::vec3(0.0f);  // a checkerboard: means 1, 0, 0.5
+      clear[i] = glm::vec3(0.01f * static_cast<float>(y / 2), 0.5f, 0.25f);
+      overcast[i] = glm::vec3(1.0f / glm::pi<float>());
+      sun[w * h + i] = glm::vec3(1e6f);  // the sky layer is not the map
+    }
+  }
+  const std::shared_ptr<const EnvMapParts> parts = ShrinkEnvMapParts(w, h, sun, clear, overcast);
+  ASSERT_NE(parts, nullptr);
+  ASSERT_EQ(parts->width, kEnvMapWidth);
+  ASSERT_EQ(parts->height, kEnvMapHeight);
+  for (const glm::vec3& t : parts->sun) ASSERT_NEAR(glm::distance(t, glm::vec3(1.0f, 0.0f, 0.5f)), 0.0f, 1e-5f);
+
+  LightingServer server(ServerOptions{}, "{}");
+  auto frame = Frame(5);
+  frame->overcast_share = 0.25;
+  frame->envmap = parts;
+  server.Publish(frame);
+  httplib::Client client("127.0.0.1", server.port());
+  const httplib::Result res = client.Get("/envmap");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200);
+  EXPECT_EQ(res->get_header_value("Content-Type"), "image/x-exr");
+  EXPECT_EQ(res->get_header_value("X-Daylit-Frame"), "5");
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / fmt::format("envmap_{}.exr", ::getpid());
+  std::ofstream(file, std::ios::binary) << res->body;
+  const scene::ExrChannels read = scene::ReadExrChannels(file, {"R", "G", "B"}, {});
+  std::filesystem::remove(file);
+  ASSERT_EQ(read.width, kEnvMapWidth);
+  ASSERT_EQ(read.height, kEnvMapHeight);
+  const std::vector<float> relit = RelitEnvMap(*parts, frame->row.light, frame->overcast_share);
+  const estimation::LightParts e = estimation::SplitLight(frame->row.light, frame->overcast_share);
+  for (size_t i = 0; i < relit.size() / 3; ++i) {
+    const glm::vec3 want = e.sun * parts->sun[i] + e.clear * parts->clear[i] + e.overcast * parts->overcast[i];
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_NEAR(relit[3 * i + c], want[c], 1e-4f * want[c]);
+      ASSERT_NEAR(read.planes[static_cast<size_t>(c)][i], want[c], 1e-3f * want[c]) << "texel " << i << " channel " << c;  // half: 11 bits
+    }
+  }
+}
+
+// The camera frame as /frame.jpg and /video.mjpg: a smooth picture comes back within JPEG's
+// error, and the video sends each new frame as its own part, numbered.
+TEST(LightingServerTest, FrameAndVideoAreTheLatestCameraFrameAsJpeg) {
+  LightingServer server(ServerOptions{}, "{}");
+  httplib::Client client("127.0.0.1", server.port());
+  EXPECT_EQ(client.Get("/frame.jpg")->status, 503);
+  const auto picture = [](float shift) {
+    cv::Mat rgb(48, 64, CV_32FC3);
+    for (int y = 0; y < rgb.rows; ++y) {
+      for (int x = 0; x < rgb.cols; ++x) rgb.at<cv::Vec3f>(y, x) = cv::Vec3f(static_cast<float>(x) / 64.0f, static_cast<float>(y) / 48.0f, shift);
+    }
+    return rgb;
+  };
+  auto first = Frame(7);
+  first->image = picture(0.5f);
+  server.Publish(first);
+  const httplib::Result res = client.Get("/frame.jpg");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 200);
+  EXPECT_EQ(res->get_header_value("X-Daylit-Frame"), "7");
+  const cv::Mat bgr = cv::imdecode(std::vector<uchar>(res->body.begin(), res->body.end()), cv::IMREAD_COLOR);
+  ASSERT_EQ(bgr.cols, 64);
+  ASSERT_EQ(bgr.rows, 48);
+  double worst = 0.0;
+  for (int y = 0; y < bgr.rows; ++y) {
+    for (int x = 0; x < bgr.cols; ++x) {
+      const cv::Vec3b got = bgr.at<cv::Vec3b>(y, x);
+      const cv::Vec3f want = first->image.at<cv::Vec3f>(y, x) * 255.0f;
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(got[2 - c] - static_cast<double>(want[c])));
+    }
+  }
+  EXPECT_LT(worst, 6.0) << "codes";  // quality 90 on a smooth gradient
+
+  std::vector<int> parts;
+  std::thread reader([&] {
+    httplib::Client video("127.0.0.1", server.port());
+    video.set_read_timeout(5, 0);
+    std::string buffer;
+    video.Get("/video.mjpg", [&](const char* data, size_t size) {
+      buffer.append(data, size);
+      for (;;) {
+        const size_t head_end = buffer.find("\r\n\r\n");
+        if (head_end == std::string::npos) return true;
+        const std::string head = buffer.substr(0, head_end);
+        const size_t length_at = head.find("Content-Length: "), frame_at = head.find("X-Daylit-Frame: ");
+        EXPECT_EQ(head.rfind("--daylitframe\r\nContent-Type: image/jpeg", 0), 0u) << head;
+        if (length_at == std::string::npos || frame_at == std::string::npos) return false;
+        const size_t length = std::stoul(head.substr(length_at + 16));
+        if (buffer.size() < head_end + 4 + length + 2) return true;
+        const std::vector<uchar> jpeg(buffer.begin() + static_cast<long>(head_end + 4),
+                                      buffer.begin() + static_cast<long>(head_end + 4 + length));
+        EXPECT_FALSE(cv::imdecode(jpeg, cv::IMREAD_COLOR).empty());
+        parts.push_back(std::stoi(head.substr(frame_at + 16)));
+        buffer.erase(0, head_end + 4 + length + 2);
+        if (parts.back() == 8) return false;
+      }
+    });
+  });
+  ASSERT_TRUE(Eventually([&] { return server.stats().clients_seen == 1; }));
+  auto second = Frame(8);
+  second->image = picture(0.25f);
+  // Published until the reader has seen it: it may have joined after the first publish.
+  ASSERT_TRUE(Eventually([&] {
+    server.Publish(second);
+    return server.stats().jpegs >= 2;
+  }));
+  reader.join();
+  ASSERT_FALSE(parts.empty());
+  EXPECT_EQ(parts.back(), 8);
+  EXPECT_TRUE(std::is_sorted(parts.begin(), parts.end()));
+  EXPECT_EQ(server.stats().jpegs, 2u) << "one JPEG per frame";
+}
+
+// The viewer at /: index.html and three.js from web/ (scripts/setup.sh); without those files,
+// / says how to install them and everything else is served as ever.
+TEST(LightingServerTest, TheViewerIsServedFromWebOrItsAbsenceSaid) {
+  LightingServer server(ServerOptions{}, "{}");
+  httplib::Client client("127.0.0.1", server.port());
+  const httplib::Result root = client.Get("/");
+  ASSERT_TRUE(root);
+  EXPECT_EQ(root->status, 302);
+  EXPECT_EQ(root->get_header_value("Location"), "/viewer/index.html");
+  const httplib::Result index = client.Get("/viewer/index.html");
+  ASSERT_TRUE(index);
+  EXPECT_NE(index->body.find("/three/three.module.js"), std::string::npos);
+  const httplib::Result three = client.Get("/three/three.module.js");
+  ASSERT_TRUE(three);
+  EXPECT_EQ(three->status, 200);
+  EXPECT_GT(three->body.size(), 100000u);
+  EXPECT_EQ(client.Get("/three/../../package.json")->status, 404);  // nothing outside the mounts
+
+  ServerOptions bare;
+  bare.web_dir = (std::filesystem::temp_directory_path() / "no-such-web-dir").string();
+  LightingServer without(bare, "{}");
+  httplib::Client other("127.0.0.1", without.port());
+  const httplib::Result said = other.Get("/");
+  ASSERT_TRUE(said);
+  EXPECT_NE(said->body.find("run scripts/setup.sh"), std::string::npos) << said->body;
+  EXPECT_EQ(other.Get("/viewer/index.html")->status, 404);
 }
 
 }  // namespace

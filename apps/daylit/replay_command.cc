@@ -2,11 +2,13 @@
 // capture, sun, estimation, relighting, irradiance volume, compositing) into an augmented H.264
 // video, with the estimates, their plot and a report beside it (docs/render.md).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -50,6 +52,8 @@ struct ReplayOptions {
   std::string lighting = "volume";
   double calibrate_s = 0.0;  // live: fit north on this many seconds of the camera first
   std::string serve;         // [HOST:]PORT of the lighting server; empty: none
+  bool pace = false;         // a recording at its own pace (as in a window)
+  bool hold = false;         // --serve: keep serving the last frame after the run, until Ctrl-C
 };
 
 // What GET /scene tells a renderer that places its own camera (docs/serve.md).
@@ -72,6 +76,26 @@ std::string SceneJson(const scene::Scene& scene) {
         {"world_to_camera", {{"rotation", rotation}, {"translation", {t.x, t.y, t.z}}}},
         {"center", {center.x, center.y, center.z}}}},
   };
+  j["camera"]["response"] = scene.response.Describe();
+  j["camera"]["exposure"] = scene.exposure;
+  nlohmann::json objects = nlohmann::json::array();
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const scene::VirtualObject& o = scene.objects[i];
+    const glm::dvec3 albedo = o.albedo.value_or(glm::dvec3(0.5));
+    nlohmann::json object = {
+        {"position", {o.position.x, o.position.y, o.position.z}},
+        {"rotation_deg", {o.rotation_deg.x, o.rotation_deg.y, o.rotation_deg.z}},
+        {"scale", {o.scale.x, o.scale.y, o.scale.z}},
+        {"albedo", {albedo.x, albedo.y, albedo.z}},
+    };
+    switch (o.kind) {
+      case scene::MeshKind::kSphere: object["mesh"] = "sphere", object["radius"] = o.radius; break;
+      case scene::MeshKind::kBox: object["mesh"] = "box", object["size"] = {o.size.x, o.size.y, o.size.z}; break;
+      case scene::MeshKind::kFile: object["mesh"] = "file", object["file"] = o.file.filename().string(); break;
+    }
+    objects.push_back(std::move(object));
+  }
+  j["objects"] = std::move(objects);
   if (scene.volume) {
     j["volume"] = {{"min", {scene.volume->min.x, scene.volume->min.y, scene.volume->min.z}},
                    {"max", {scene.volume->max.x, scene.volume->max.y, scene.volume->max.z}}};
@@ -80,18 +104,30 @@ std::string SceneJson(const scene::Scene& scene) {
 }
 
 // Each frame's lighting to the lighting server: the estimate, the sun in scene and camera
-// coordinates, and the irradiance volume as the renderer left it (a copy of its coefficients).
+// coordinates, the irradiance volume as the renderer left it (a copy of its coefficients), the
+// relit map's parts (shrunk once per sun) and the camera frame (shared, not copied).
 class ServeSink : public pipeline::FrameSink {
  public:
   ServeSink(const scene::Scene& scene, const render::FrameRenderer& renderer, serve::LightingServer* server)
-      : scene_(scene), renderer_(renderer), server_(server) {}
+      : scene_(scene), renderer_(renderer), server_(server),
+        response_(std::make_shared<const capture::CameraResponse>(scene.response)) {}
   void Consume(const pipeline::PipelineFrame& f) override {
     auto l = std::make_shared<serve::FrameLighting>();
     l->row = f.light.row;
+    l->exposure = f.frame.exposure;
     l->overcast_share = f.light.overcast_share;
     l->sun_scene = f.sun.dir_in_scene;
     l->sun_camera = glm::vec3(scene_.cam_from_world.rotation * glm::dvec3(f.sun.dir_in_scene));
     if (const sh::IrradianceVolume* volume = renderer_.volume()) volume->Snapshot(&l->volume);
+    if (renderer_.env_basis_generation() != envmap_generation_) {
+      const relight::EnvBasis& basis = renderer_.env_basis();
+      const relight::EnvRelighter& map = renderer_.relighter();
+      envmap_ = serve::ShrinkEnvMapParts(map.width(), map.height(), basis.sun, basis.clear, basis.overcast);
+      envmap_generation_ = renderer_.env_basis_generation();
+    }
+    l->envmap = envmap_;
+    l->image = f.frame.rgb;
+    if (f.frame.linear) l->linear_response = response_;
     server_->Publish(std::move(l));
   }
 
@@ -99,6 +135,9 @@ class ServeSink : public pipeline::FrameSink {
   const scene::Scene& scene_;
   const render::FrameRenderer& renderer_;
   serve::LightingServer* server_;
+  std::shared_ptr<const capture::CameraResponse> response_;
+  std::shared_ptr<const serve::EnvMapParts> envmap_;
+  int envmap_generation_ = 0;
 };
 
 // daylit live --calibrate: the camera's first `seconds` through the estimator, north fitted on
@@ -194,6 +233,7 @@ void RunReplay(const ReplayOptions& o) {
   if (!o.screenshot.empty() && !o.window) ThrowInputError("--screenshot: needs --window");
   if (!o.screenshot.empty() && fs::path(o.screenshot).extension() != ".png") ThrowInputError("--screenshot: {} must end in .png", o.screenshot);
   if (!o.relight_at.empty() && !o.window) ThrowInputError("--relight-at: needs --window (daylit relight writes a relit video)");
+  if (o.hold && o.serve.empty()) ThrowInputError("--hold: needs --serve");
   // The port is taken before any work, so that a port in use fails at once.
   std::optional<serve::LightingServer> server;
   if (!o.serve.empty()) server.emplace(serve::ParseHostPort(o.serve, "--serve"), SceneJson(scene));
@@ -204,7 +244,7 @@ void RunReplay(const ReplayOptions& o) {
   // Everything that can fail without the bake fails before it: the frames, GL, the output.
   std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
   // In a window, a recording plays at its own pace; a camera paces itself.
-  if (o.window && scene.frame_times) source = capture::Paced(std::move(source), 1.0);
+  if ((o.window || o.pace) && scene.frame_times) source = capture::Paced(std::move(source), 1.0);
   std::optional<pipeline::VideoOutput> video;
   if (!o.window || o.out_given) video.emplace(out, scene);
   std::string why;
@@ -247,6 +287,11 @@ void RunReplay(const ReplayOptions& o) {
   WriteReplayReport(scene, run, renderer, fidelity, o.live, gl ? gl->renderer() : std::string(), dir);
   Log().info("wrote {}estimates.csv, lighting.png, report.txt, figures.json{} in {}", video ? out.filename().string() + ", " : "",
              fidelity.frames().empty() ? "" : ", fidelity.csv, fidelity.png, worst_vs_truth.png", dir.string());
+  if (server && o.hold) {
+    Log().info("--hold: still serving frame {} on port {}; Ctrl-C ends it", run.frames.empty() ? -1 : run.frames.back().frame,
+               server->port());
+    while (!interrupt.flag()->load()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
 }
 
 }  // namespace
@@ -269,7 +314,10 @@ void AddPipelineOptions(CLI::App* cmd, const std::shared_ptr<ReplayOptions>& opt
                   "relit to the sun of that time on their own day (daylit relight's ratio), objects included");
   cmd->add_option("--serve", options->serve,
                   "Serve each frame's lighting over HTTP while it runs, on [HOST:]PORT (host 127.0.0.1 unless given): "
-                  "GET /lighting, /stream (Server-Sent Events), /scene (docs/serve.md)");
+                  "GET /lighting, /stream (Server-Sent Events), /scene, /envmap, /frame.jpg, /video.mjpg and the "
+                  "browser viewer at / (docs/serve.md); port 0: any free one (the log names it)");
+  cmd->add_flag("--pace", options->pace, "Play a recording at its own pace (as --window does), e.g. for a viewer of --serve");
+  cmd->add_flag("--hold", options->hold, "With --serve: after the last frame, keep serving it until Ctrl-C");
   cmd->callback([options, out] {
     options->out_given = out->count() > 0;
     RunReplay(*options);
