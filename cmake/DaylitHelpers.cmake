@@ -43,12 +43,16 @@ set(DAYLIT_TEST_ENVIRONMENT
 # (base/test_main.cc) keeps HOME, the XDG folders and TMPDIR inside the build tree. FIXTURES: the
 # CTest fixture its tests need (courtyard_bakes, the bundled recordings' bakes: tests/). LABELS:
 # `accuracy` marks a binary whose tests measure whole recordings against the path tracer; the
-# sanitizer pass of scripts/test.sh leaves those out (the same code runs there in smaller tests).
+# sanitizer pass of scripts/test.sh leaves those out (the same code runs there in smaller tests),
+# and its build does not make them (DAYLIT_ACCURACY_TESTS=OFF).
 function(daylit_add_test)
   if(NOT DAYLIT_BUILD_TESTS)
     return()
   endif()
   cmake_parse_arguments(ARG "" "NAME;ENVIRONMENT;FIXTURES;LABELS" "SRCS;LINK_LIBS" ${ARGN})
+  if(ARG_LABELS STREQUAL "accuracy" AND NOT DAYLIT_ACCURACY_TESTS)
+    return()
+  endif()
   file(RELATIVE_PATH folder ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR})
   add_executable(${ARG_NAME} ${ARG_SRCS})
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_LINK_LIBS} daylit_test_main)
