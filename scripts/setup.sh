@@ -13,7 +13,7 @@ packages=(
   libgl1-mesa-dri libgbm-dev libopenexr-dev libimath-dev libembree-dev libtbb-dev
   libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
   libcpp-httplib-dev libspdlog-dev libfmt-dev libtinyobjloader-dev libtinygltf-dev libstb-dev liberfa-dev
-  ffmpeg xvfb xauth clang libclang-rt-14-dev chromium
+  ffmpeg xvfb xauth clang libclang-rt-14-dev chromium faketime
 )
 
 missing=()

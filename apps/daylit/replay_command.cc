@@ -169,6 +169,15 @@ scene::Scene CalibrateOnTheCamera(const scene::Scene& scene, const bake::SceneBa
                fit.north_offset_deg, scene.north_azimuth_deg);
     return calibrated;
   }
+  // A fit no surer than issue 19's bar on north would move it at random: kept out, and said.
+  constexpr double kNorthSigmaBarDeg = 0.3;
+  if (!(fit.north_sigma_deg <= kNorthSigmaBarDeg)) {
+    Log().warn("--calibrate: the camera's first {:g} s constrain north only to ±{:.2f} deg ({} clear frames, {} shadow-edge "
+               "pixels; fitted {:+.3f}): north left at {:.3f} deg; calibrate on a longer stretch with clear sun, or run "
+               "daylit calibrate-scene on a recording",
+               seconds, fit.north_sigma_deg, fit.frames, fit.edge_pixels, fit.north_offset_deg, scene.north_azimuth_deg);
+    return calibrated;
+  }
   calibrated.north_azimuth_deg += fit.north_offset_deg;
   Log().info("--calibrate: north {:.3f} -> {:.3f} deg ({:+.3f} ± {:.3f}) from {} frames of the camera, {} shadow-edge pixels "
              "({:.1f}% on the wrong side before, {:.1f}% after); the clock held (one time of day); write "
