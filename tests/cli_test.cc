@@ -1039,6 +1039,9 @@ TEST(CliTest, ServeOnAPortInUseOrNotAPortExitsWithCode2BeforeAnyWork) {
   const CliRun bad = Daylit("replay " + kRecording + " --serve localhost:http" + common);
   EXPECT_EQ(bad.exit_code, 2) << bad.err;
   EXPECT_NE(bad.err.find("--serve: 'localhost:http' is not [HOST:]PORT"), std::string::npos) << bad.err;
+  const CliRun hold = Daylit("replay " + kRecording + " --hold" + common);  // nothing to hold without a server
+  EXPECT_EQ(hold.exit_code, 2) << hold.err;
+  EXPECT_NE(hold.err.find("--hold: needs --serve"), std::string::npos) << hold.err;
   EXPECT_FALSE(fs::exists(dir / "cache"));
   EXPECT_FALSE(fs::exists(dir / "r.mp4"));
   close(fd);
