@@ -16,6 +16,22 @@
 
 namespace daylit::estimation {
 
+std::vector<size_t> FairShares(const std::vector<size_t>& sizes, size_t total) {
+  std::vector<size_t> order(sizes.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return sizes[a] < sizes[b]; });
+  std::vector<size_t> shares(sizes.size(), 0);
+  size_t left = total;
+  for (size_t j = 0; j < order.size(); ++j) {
+    const size_t fair = (left + (order.size() - j) - 1) / (order.size() - j);  // rounded up
+    shares[order[j]] = std::min(fair, sizes[order[j]]);
+    left -= std::min(left, shares[order[j]]);
+  }
+  return shares;
+}
+
+
+
 Sampler::Sampler(const bake::SceneBake& bake, const glm::vec3& capture_position, const scene::RayCaster& caster,
                  SamplerOptions options)
     : gbuffer_(bake.camera), caster_(caster), options_(options),
@@ -79,14 +95,15 @@ bool Sampler::SetSun(const glm::vec3& sun_dir) {
     if (inserted) strata.emplace_back();
     strata[it->second].push_back(i);
   }
-  // Each stratum's pool: the first pixels of its list, with their transfer under this sun.
-  const size_t pool = strata.empty() ? 0
-                                     : static_cast<size_t>(std::ceil(options_.pool * options_.samples /
-                                                                     static_cast<double>(strata.size()))) + 1;
+  // Each stratum's pool: the first pixels of its list, its fair share of `pool` × the samples,
+  // with their transfer under this sun.
+  std::vector<size_t> sizes(strata.size());
+  for (size_t s = 0; s < strata.size(); ++s) sizes[s] = strata[s].size();
+  const std::vector<size_t> pools = FairShares(sizes, static_cast<size_t>(std::ceil(options_.pool * options_.samples)));
   std::vector<uint32_t> pooled;
-  for (std::vector<uint32_t>& stratum : strata) {
-    stratum.resize(std::min(stratum.size(), pool));
-    pooled.insert(pooled.end(), stratum.begin(), stratum.end());
+  for (size_t s = 0; s < strata.size(); ++s) {
+    strata[s].resize(pools[s]);
+    pooled.insert(pooled.end(), strata[s].begin(), strata[s].end());
   }
   std::vector<Transfer> transfer(pooled.size());
   transfer_.Compute(pooled, sun_dir, sun_term_.data(), transfer.data());
@@ -102,9 +119,15 @@ std::vector<Sample> Sampler::Draw(const cv::Mat& frame, double exposure, const c
   std::vector<Sample> samples;
   if (strata_.empty() || frame.empty()) return samples;
   samples.reserve(static_cast<size_t>(options_.samples));
-  const size_t quota = static_cast<size_t>(options_.samples) / strata_.size() + 1;
+  // Each stratum's quota: its fair share of the samples, over the pools (FairShares). A pool
+  // holds `pool` × its quota, room for the pixels a frame skips as clipped or black.
+  std::vector<size_t> sizes(strata_.size());
+  for (size_t s = 0; s < strata_.size(); ++s) sizes[s] = strata_[s].size();
+  const std::vector<size_t> quotas = FairShares(sizes, static_cast<size_t>(options_.samples));
   const float inv_exposure = static_cast<float>(1.0 / exposure);
-  for (const std::vector<Candidate>& stratum : strata_) {
+  for (size_t t = 0; t < strata_.size(); ++t) {
+    const std::vector<Candidate>& stratum = strata_[t];
+    const size_t quota = quotas[t];
     size_t taken = 0;
     for (size_t k = 0; k < stratum.size() && taken < quota; ++k) {
       const uint32_t i = stratum[k].pixel;

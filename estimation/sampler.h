@@ -24,7 +24,8 @@
 namespace daylit::estimation {
 
 struct SamplerOptions {
-  int samples = 8000;                // per frame, split evenly over the strata that exist
+  int samples = 8000;                // per frame, shared fairly over the strata that exist: each its
+                                     // pixels up to an equal share of what smaller strata leave
   int boundary_margin_px = 3;        // pixels this close to a shadow edge or silhouette are left out
   double saturated = 0.98;           // linear pixel value (before exposure) treated as clipped
   double near_black = 0.002;         // linear pixel value below which noise dominates
@@ -34,6 +35,12 @@ struct SamplerOptions {
   // Empty when every field is in range, else the first problem, naming the field.
   std::string Check() const;
 };
+
+// `total` shared over groups of the given sizes (the strata's pools, or their quotas): each group
+// all of its members up to an equal share of what the smaller groups leave (water-filling). A
+// group of a few members takes only those, so one that appears or goes as the sun moves changes
+// the others' shares by little; an equal split, total / groups, would change every one of them.
+std::vector<size_t> FairShares(const std::vector<size_t>& sizes, size_t total);
 
 class Sampler {
  public:

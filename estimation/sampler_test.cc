@@ -150,5 +150,19 @@ TEST(SamplerTest, SunVisibilityIsRecastOnlyForAnotherSun) {
   EXPECT_NEAR(fit.light.sky_rgb.z, 0.9, 0.9e-3);
 }
 
+// The samples' shares: a stratum of a few pixels takes only those, and its coming or going moves
+// the others' shares by at most the few pixels it takes (an equal split moved each by a quarter).
+TEST(FairSharesTest, ASliverTakesOnlyItsPixelsAndBarelyMovesTheOthers) {
+  EXPECT_EQ(FairShares({5000, 5000, 5000}, 8000), (std::vector<size_t>{2667, 2667, 2666}));
+  const std::vector<size_t> with_sliver = FairShares({5000, 3, 5000, 5000}, 8000);
+  EXPECT_EQ(with_sliver, (std::vector<size_t>{2666, 3, 2666, 2665}));
+  size_t sum = 0;
+  for (const size_t share : with_sliver) sum += share;
+  EXPECT_EQ(sum, 8000u);
+  EXPECT_EQ(FairShares({100, 200}, 8000), (std::vector<size_t>{100, 200}));  // fewer pixels than asked: all of them
+  EXPECT_EQ(FairShares({100, 9000}, 8000), (std::vector<size_t>{100, 7900}));  // the rest to the large one
+  EXPECT_TRUE(FairShares({}, 8000).empty());
+}
+
 }  // namespace
 }  // namespace daylit::estimation
