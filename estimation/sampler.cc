@@ -30,8 +30,6 @@ std::vector<size_t> FairShares(const std::vector<size_t>& sizes, size_t total) {
   return shares;
 }
 
-
-
 Sampler::Sampler(const bake::SceneBake& bake, const glm::vec3& capture_position, const scene::RayCaster& caster,
                  SamplerOptions options)
     : gbuffer_(bake.camera), caster_(caster), options_(options),
@@ -112,6 +110,9 @@ bool Sampler::SetSun(const glm::vec3& sun_dir) {
   for (size_t s = 0; s < strata.size(); ++s) {
     for (const uint32_t i : strata[s]) strata_[s].push_back({i, transfer[k++]});
   }
+  // Each stratum's quota per frame: its fair share of the samples over the pools. A pool holds
+  // `pool` × its quota, room for the pixels a frame skips as clipped or black.
+  quotas_ = FairShares(pools, static_cast<size_t>(options_.samples));
   return true;
 }
 
@@ -119,15 +120,10 @@ std::vector<Sample> Sampler::Draw(const cv::Mat& frame, double exposure, const c
   std::vector<Sample> samples;
   if (strata_.empty() || frame.empty()) return samples;
   samples.reserve(static_cast<size_t>(options_.samples));
-  // Each stratum's quota: its fair share of the samples, over the pools (FairShares). A pool
-  // holds `pool` × its quota, room for the pixels a frame skips as clipped or black.
-  std::vector<size_t> sizes(strata_.size());
-  for (size_t s = 0; s < strata_.size(); ++s) sizes[s] = strata_[s].size();
-  const std::vector<size_t> quotas = FairShares(sizes, static_cast<size_t>(options_.samples));
   const float inv_exposure = static_cast<float>(1.0 / exposure);
   for (size_t t = 0; t < strata_.size(); ++t) {
     const std::vector<Candidate>& stratum = strata_[t];
-    const size_t quota = quotas[t];
+    const size_t quota = quotas_[t];
     size_t taken = 0;
     for (size_t k = 0; k < stratum.size() && taken < quota; ++k) {
       const uint32_t i = stratum[k].pixel;

@@ -77,6 +77,7 @@ class Sampler {
     Transfer transfer;
   };
   std::vector<std::vector<Candidate>> strata_;  // the pool of each stratum, in the shuffled order
+  std::vector<size_t> quotas_;                  // samples each stratum gives a frame (FairShares)
 };
 
 }  // namespace daylit::estimation

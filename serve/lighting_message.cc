@@ -10,8 +10,11 @@ namespace {
 
 nlohmann::json Xyz(const glm::dvec3& v) { return {{"x", v.x}, {"y", v.y}, {"z", v.z}}; }
 
+// The first width × height values of `map` (a stacked basis may carry more after them),
+// area-averaged to out_width × out_height.
 std::vector<glm::vec3> Shrink(int width, int height, const std::vector<glm::vec3>& map, int out_width, int out_height) {
-  if (out_width == width && out_height == height) return map;
+  const size_t n = static_cast<size_t>(width) * static_cast<size_t>(height);
+  if (out_width == width && out_height == height) return {map.begin(), map.begin() + static_cast<long>(n)};
   const cv::Mat in(height, width, CV_32FC3, const_cast<glm::vec3*>(map.data()));
   std::vector<glm::vec3> out(static_cast<size_t>(out_width) * static_cast<size_t>(out_height));
   cv::Mat shrunk(out_height, out_width, CV_32FC3, out.data());
@@ -30,10 +33,9 @@ std::shared_ptr<const EnvMapParts> ShrinkEnvMapParts(int width, int height, cons
   parts->width = std::min(width, kEnvMapWidth);
   parts->height = std::min(height, kEnvMapHeight);
   // The stacked bases (relight::EnvBasis) carry a sky layer after the map: only the map is shrunk.
-  const auto map = [n](const std::vector<glm::vec3>& v) { return std::vector<glm::vec3>(v.begin(), v.begin() + static_cast<long>(n)); };
-  parts->sun = Shrink(width, height, map(sun), parts->width, parts->height);
-  parts->clear = Shrink(width, height, map(clear), parts->width, parts->height);
-  parts->overcast = Shrink(width, height, map(overcast), parts->width, parts->height);
+  parts->sun = Shrink(width, height, sun, parts->width, parts->height);
+  parts->clear = Shrink(width, height, clear, parts->width, parts->height);
+  parts->overcast = Shrink(width, height, overcast, parts->width, parts->height);
   return parts;
 }
 

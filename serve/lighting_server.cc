@@ -237,8 +237,7 @@ LightingServer::LightingServer(const ServerOptions& options, std::string scene_j
   viewer_ = std::filesystem::is_regular_file(web / "viewer" / "index.html") &&
             std::filesystem::is_regular_file(web / "node_modules" / "three" / "build" / "three.module.js") &&
             s.set_mount_point("/viewer", (web / "viewer").string()) &&
-            s.set_mount_point("/three", (web / "node_modules" / "three" / "build").string()) &&
-            s.set_mount_point("/three-addons", (web / "node_modules" / "three" / "examples" / "jsm").string());
+            s.set_mount_point("/three", (web / "node_modules" / "three" / "build").string());
   s.set_file_extension_and_mimetype_mapping("mjs", "text/javascript");
   s.Get("/", [this, web](const httplib::Request&, httplib::Response& res) {
     if (viewer_) {

@@ -11,6 +11,7 @@ import { mkdirSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { chromium } from 'playwright-core';
 import { PNG } from 'pngjs';
+import { shIrradiance } from '../viewer/sh.mjs';
 
 const [daylit, recording, cache, work, clearFrames, cloudFrames] = process.argv.slice(2);
 let failures = 0;
@@ -61,14 +62,6 @@ function project(cam, p) {
 const srgbToLinear = (v) => (v <= 0.04045 ? v / 12.92 : Math.pow((v + 0.055) / 1.055, 2.4));
 const norm = (v) => { const l = Math.hypot(...v); return v.map((x) => x / l); };
 const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-function shIrradiance(c, n) {
-  const [x, y, z] = n;
-  const w = [0.886227, 1.023328 * y, 1.023328 * z, 1.023328 * x, 0.858086 * x * y, 0.858086 * y * z,
-             0.743125 * z * z - 0.247708, 0.858086 * x * z, 0.429043 * (x * x - y * y)];
-  const e = [0, 0, 0];
-  for (let k = 0; k < 9; ++k) for (let ch = 0; ch < 3; ++ch) e[ch] += w[k] * c[3 * k + ch];
-  return e;
-}
 
 async function measure(browser, frames, name) {
   const dir = join(work, name);

@@ -3,6 +3,7 @@
 // Radiance units become the camera's linear pixel values through the frame's exposure k, and
 // three.js encodes them with sRGB, the response of the bundled recordings.
 import * as THREE from 'three';
+import { shIrradiance } from '/viewer/sh.mjs';
 
 const status = document.getElementById('status');
 const view = document.getElementById('view');
@@ -49,16 +50,6 @@ function objectMesh(o) {
   mesh.castShadow = true;
   mesh.receiveShadow = true;
   return mesh;
-}
-
-// E(n) of radiance SH coefficients (the message's order and factors; three.js's own).
-function shIrradiance(c, n) {
-  const [x, y, z] = n;
-  const w = [0.886227, 1.023328 * y, 1.023328 * z, 1.023328 * x, 0.858086 * x * y, 0.858086 * y * z,
-             0.743125 * z * z - 0.247708, 0.858086 * x * z, 0.429043 * (x * x - y * y)];
-  const e = [0, 0, 0];
-  for (let k = 0; k < 9; ++k) for (let ch = 0; ch < 3; ++ch) e[ch] += w[k] * c[3 * k + ch];
-  return e;
 }
 
 async function main() {
