@@ -34,6 +34,10 @@ struct ObserveOptions {
   // Pixels this close to an edge between two surfaces (or the sky) in the bake's G-buffer are left
   // out: where the pose is off, they show the other surface (pose refinement sets ~a degree's worth).
   int silhouette_margin_px = 0;
+  // > 0: a burst longer than this (seconds) is cut into stretches this long, each its own burst
+  // with its own sun. A live camera's stream is one burst, and over ten minutes the sun moves
+  // 2.5°: a median over frames that far apart would blur the shadows it measures.
+  double max_burst_s = 0.0;
 };
 
 // One burst's view of the shadows.
@@ -62,6 +66,8 @@ class ShadowObserver {
   // A frame that could not be read: it still ends a burst.
   void AddUnreadable(const capture::Frame& frame);
   ShadowObservations Finish();
+  // Bursts closed so far that showed the sun on the model (they will be in Finish's bursts).
+  size_t sunlit_bursts() const { return out_.bursts.size(); }
 
  private:
   struct ClearFrame {
@@ -82,6 +88,7 @@ class ShadowObserver {
   std::vector<float> radiance_;
   int first_ = 0, last_ = 0;
   std::optional<UtcTime> previous_;
+  UtcTime start_;                  // the burst's (or stretch's) first frame
   ShadowObservations out_;
 };
 

@@ -19,7 +19,10 @@
 #include "base/atomic_file.h"
 #include "base/csv.h"
 #include "calibrate/shadow_calibration.h"
+#include "capture/frame_source.h"
+#include "estimation/frame_estimator.h"
 #include "scene/raycaster.h"
+#include "scene/sun_tracker.h"
 #include "tests/cli_run.h"
 #include "tests/courtyard_fixture.h"
 
@@ -205,6 +208,42 @@ TEST(CalibrateEndToEndTest, ANorthBeyondTheSearchRangeIsSaidAndTheSceneLeftAlone
   EXPECT_EQ(ReadTextFile(dir / "scene.json"), original);
   EXPECT_FALSE(fs::exists(dir / "scene.json.bak"));
   fs::remove_all(dir), fs::remove_all(cache);
+}
+
+// A live camera's stream is one burst however long it runs; ObserveOptions::max_burst_s cuts it
+// into stretches, each with its own sun, and a stretch that shows the sun is counted as soon as the
+// next one starts (live --calibrate stops there). courtyard-a's first burst (10 s at 10 fps) cut
+// every 3 s: four stretches, frames 0-29, 30-59, 60-89 and 90-99, the first counted at frame 30.
+TEST(ShadowObserverTest, ALongBurstIsCutIntoStretchesEachWithItsOwnSun) {
+  const testing::BundledCourtyard& c = testing::Courtyard();
+  const scene::RayCaster caster(c.scene.model);
+  calibrate::ObserveOptions options;
+  options.max_burst_s = 3.0;
+  calibrate::ShadowObserver observer(c.scene, c.bake, options);
+  std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(c.scene);
+  scene::SunTracker tracker(c.scene);
+  estimation::FrameEstimator estimator(c.scene, c.bake, caster, {});
+  int first_counted = -1;
+  for (int i = 0; i < 100; ++i) {
+    capture::Frame frame;
+    ASSERT_EQ(source->Next(&frame), capture::FrameStatus::kFrame) << i;
+    observer.Add(frame, estimator.Estimate(frame, tracker.Update(frame.utc)).row);
+    if (first_counted < 0 && observer.sunlit_bursts() > 0) first_counted = frame.index;
+  }
+  EXPECT_EQ(first_counted, 30);
+  const calibrate::ShadowObservations observed = observer.Finish();
+  EXPECT_EQ(observed.bursts_seen, 4);
+  ASSERT_EQ(observed.bursts.size(), 4u);
+  const int firsts[] = {0, 30, 60, 90}, lasts[] = {29, 59, 89, 99};
+  for (size_t k = 0; k < observed.bursts.size(); ++k) {
+    const calibrate::BurstShadows& b = observed.bursts[k];
+    EXPECT_EQ(b.first_frame, firsts[k]) << k;
+    EXPECT_EQ(b.last_frame, lasts[k]) << k;
+    // Its time is its own frames' (a clear frame's within it), not the burst's.
+    const double t = b.time.SecondsSince(c.scene.frame_times->frames[0].utc);
+    EXPECT_GE(t, 0.1 * firsts[k] - 1e-6) << k;
+    EXPECT_LE(t, 0.1 * lasts[k] + 1e-6) << k;
+  }
 }
 
 // daylit live --calibrate against a camera: the userspace V4L2 test device (tests/fakecam) serves a

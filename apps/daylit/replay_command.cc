@@ -140,9 +140,12 @@ class ServeSink : public pipeline::FrameSink {
   int envmap_generation_ = 0;
 };
 
-// daylit live --calibrate: the camera's first `seconds` through the estimator, north fitted on
-// their shadows (one time of day: the clock is held), and the scene with it. The frames read go
-// only to the fit.
+// daylit live --calibrate: the camera's frames through the estimator, for at most `seconds`, cut
+// into minutes (the sun moves 0.25° in one), until the first minute that shows the sun clearly on
+// the model; north is fitted on its shadows (one time of day: the clock is held), and the scene
+// with it. The frames read go only to the fit.
+constexpr double kCalibrationStretchS = 60.0;
+
 scene::Scene CalibrateOnTheCamera(const scene::Scene& scene, const bake::SceneBake& baked, const scene::RayCaster& caster,
                                   capture::FrameSource* source, double seconds, const std::atomic<bool>* stop) {
   pipeline::LightingPipelineOptions options;
@@ -150,7 +153,9 @@ scene::Scene CalibrateOnTheCamera(const scene::Scene& scene, const bake::SceneBa
   options.progress_label = "calibrate";
   options.stop = stop;
   pipeline::LightingPipeline lighting(scene, baked, caster, options);
-  ShadowCheckSink shadows(scene, baked);
+  calibrate::ObserveOptions observe;
+  observe.max_burst_s = kCalibrationStretchS;
+  ShadowCheckSink shadows(scene, baked, observe, /*stop_at_first_sunlit_burst=*/true);
   lighting.AddSink(&shadows);
   lighting.Run(capture::Borrowed(source));
   const calibrate::ShadowObservations observed = shadows.Finish();
@@ -160,6 +165,7 @@ scene::Scene CalibrateOnTheCamera(const scene::Scene& scene, const bake::SceneBa
                scene.north_azimuth_deg);
     return calibrated;
   }
+  const calibrate::BurstShadows& stretch = observed.bursts.front();
   calibrate::FitOptions fit_options;
   fit_options.clock = false;
   const calibrate::FitResult fit = calibrate::Calibrate(scene, baked, caster, observed, fit_options);
@@ -172,18 +178,20 @@ scene::Scene CalibrateOnTheCamera(const scene::Scene& scene, const bake::SceneBa
   // A fit no surer than issue 19's bar on north would move it at random: kept out, and said.
   constexpr double kNorthSigmaBarDeg = 0.3;
   if (!(fit.north_sigma_deg <= kNorthSigmaBarDeg)) {
-    Log().warn("--calibrate: the camera's first {:g} s constrain north only to ±{:.2f} deg ({} clear frames, {} shadow-edge "
-               "pixels; fitted {:+.3f}): north left at {:.3f} deg; calibrate on a longer stretch with clear sun, or run "
-               "daylit calibrate-scene on a recording",
-               seconds, fit.north_sigma_deg, fit.frames, fit.edge_pixels, fit.north_offset_deg, scene.north_azimuth_deg);
+    Log().warn("--calibrate: the shadows of the camera's frames {}-{} constrain north only to ±{:.2f} deg ({} clear frames, "
+               "{} shadow-edge pixels; fitted {:+.3f}): north left at {:.3f} deg; a stretch of one time of day constrains "
+               "north as far as its shadow edges do: calibrate again under another sun, or run daylit calibrate-scene on a "
+               "recording that spans hours",
+               stretch.first_frame, stretch.last_frame, fit.north_sigma_deg, fit.frames, fit.edge_pixels, fit.north_offset_deg,
+               scene.north_azimuth_deg);
     return calibrated;
   }
   calibrated.north_azimuth_deg += fit.north_offset_deg;
-  Log().info("--calibrate: north {:.3f} -> {:.3f} deg ({:+.3f} ± {:.3f}) from {} frames of the camera, {} shadow-edge pixels "
-             "({:.1f}% on the wrong side before, {:.1f}% after); the clock held (one time of day); write "
-             "\"north_azimuth_deg\": {:.3f} into {} to keep it",
+  Log().info("--calibrate: north {:.3f} -> {:.3f} deg ({:+.3f} ± {:.3f}) from {} clear frames of the camera's frames {}-{}, "
+             "{} shadow-edge pixels ({:.1f}% on the wrong side before, {:.1f}% after); the clock held (one time of day); "
+             "write \"north_azimuth_deg\": {:.3f} into {} to keep it",
              scene.north_azimuth_deg, calibrated.north_azimuth_deg, fit.north_offset_deg, fit.north_sigma_deg, fit.frames,
-             fit.edge_pixels, 100.0 * fit.disagree_before, 100.0 * fit.disagree_after, calibrated.north_azimuth_deg,
+             stretch.first_frame, stretch.last_frame, fit.edge_pixels, 100.0 * fit.disagree_before, 100.0 * fit.disagree_after, calibrated.north_azimuth_deg,
              scene.file.string());
   return calibrated;
 }
@@ -357,8 +365,8 @@ void AddLiveCommand(CLI::App& app) {
               "--frames, Ctrl-C, or (with --window) the window is closed; the video and report are then complete.");
   cmd->add_option("--scene", options->recording, "scene.json whose frames name a camera")->required();
   cmd->add_option("--calibrate", options->calibrate_s,
-                  "First fit north on this many seconds of the camera's frames (their shadows against the model's; "
-                  "daylit calibrate-scene's method, the clock held) and run on with it")
+                  "First fit north on the camera's first clear minute within this many seconds (its shadows against "
+                  "the model's; daylit calibrate-scene's method, the clock held) and run on with it")
       ->check(CLI::Range(1.0, 600.0));
   AddPipelineOptions(cmd, options, "live.mp4");
 }

@@ -16,15 +16,21 @@ namespace daylit::app {
 
 inline constexpr double kShadowCheckNorthDeg = 0.5;
 
-// Feeds the pipeline's frames to a ShadowObserver.
+// Feeds the pipeline's frames to a ShadowObserver. With `stop_at_first_sunlit_burst` it ends the
+// run once a burst (or stretch, ObserveOptions::max_burst_s) has shown the sun on the model: live
+// --calibrate's first clear minute.
 class ShadowCheckSink final : public pipeline::FrameSink {
  public:
-  ShadowCheckSink(const scene::Scene& scene, const bake::SceneBake& bake) : observer_(scene, bake) {}
+  ShadowCheckSink(const scene::Scene& scene, const bake::SceneBake& bake, const calibrate::ObserveOptions& options = {},
+                  bool stop_at_first_sunlit_burst = false)
+      : observer_(scene, bake, options), stop_at_first_(stop_at_first_sunlit_burst) {}
   void Consume(const pipeline::PipelineFrame& frame) override;
+  bool StopRequested() const override { return stop_at_first_ && observer_.sunlit_bursts() > 0; }
   calibrate::ShadowObservations Finish() { return observer_.Finish(); }
 
  private:
   calibrate::ShadowObserver observer_;
+  bool stop_at_first_ = false;
 };
 
 // Runs the check on what was observed: warns (stderr) when the model's shadows sit where a north
