@@ -46,16 +46,9 @@ TEST(EstimateRecordingTest, CourtyardLightingWithin5PercentOfTheTruth) {
   EXPECT_EQ(run.sun_moves_ms.size(), 6u);
 }
 
-// Issue 18: every burst's median error per channel ≤ 5%, on both recordings, save the bursts
-// named here, which still miss that bar (docs/estimation.md says why) and are held to what they
-// reach now; and the 90th percentile over frames of the worst channel.
-struct BurstBar {
-  int burst;
-  double sun, sky;
-};
-
-void ExpectPerBurst(const testing::BundledCourtyard& c, const std::vector<BurstBar>& exceptions, double p90_bar,
-                    double auc_bar) {
+// Issue 18: every burst's median error per channel ≤ 5%, on both recordings, and the 90th
+// percentile over frames of the worst channel.
+void ExpectPerBurst(const testing::BundledCourtyard& c, double p90_bar, double auc_bar) {
   const scene::RayCaster caster(c.scene.model);
   pipeline::LightingPipeline lighting(c.scene, c.bake, caster, {});
   const pipeline::PipelineRun run = lighting.Run(scene::OpenFrameSource(c.scene));
@@ -64,13 +57,9 @@ void ExpectPerBurst(const testing::BundledCourtyard& c, const std::vector<BurstB
   const std::vector<evaluation::BurstLighting> bursts = evaluation::CompareBursts(run.frames, &truth);
   ASSERT_EQ(bursts.size(), c.scene.name == "courtyard-a" ? 6u : 5u);
   for (const evaluation::BurstLighting& b : bursts) {
-    BurstBar bar{b.burst.index, 0.05, 0.05};
-    for (const BurstBar& e : exceptions) {
-      if (e.burst == b.burst.index) bar = e;
-    }
     for (int ch = 0; ch < 3; ++ch) {
-      EXPECT_LE(b.sun_error[ch], bar.sun) << c.scene.name << " burst " << b.burst.index << " E_sun channel " << ch;
-      EXPECT_LE(b.sky_error[ch], bar.sky) << c.scene.name << " burst " << b.burst.index << " E_sky channel " << ch;
+      EXPECT_LE(b.sun_error[ch], 0.05) << c.scene.name << " burst " << b.burst.index << " E_sun channel " << ch;
+      EXPECT_LE(b.sky_error[ch], 0.05) << c.scene.name << " burst " << b.burst.index << " E_sky channel " << ch;
     }
   }
   EXPECT_LE(truth.p90_worst_channel_error, p90_bar) << c.scene.name;
@@ -84,18 +73,17 @@ void ExpectPerBurst(const testing::BundledCourtyard& c, const std::vector<BurstB
 }
 
 TEST(EstimateRecordingTest, CourtyardAEveryBurstWithin5Percent) {
-  // Burst 3 is overcast: the sun is 12% of its beam and E_sun blue reads 5.3% high (the aureole
-  // inside the disc the bake removes counts as sun). The 90th percentile of the worst channel is
-  // the issue's bar (measured 7.4%), and so is the confidence's AUC (measured 0.95: the bad frames
-  // are those with a weak sun, which the split's share flags).
-  ExpectPerBurst(testing::Courtyard(), {{3, 0.065, 0.05}}, 0.10, 0.90);
+  // Every burst within the issue's 5%, the overcast burst 3 too (measured: worst 3.4%, burst 5's
+  // E_sky blue; burst 3's E_sun blue 3.1%). The 90th percentile of the worst channel (measured
+  // 6.4%) and the confidence's AUC (measured 0.934 over 11 frames beyond 10%: those with a weak
+  // sun, which the split's share flags) at the issue's bars.
+  ExpectPerBurst(testing::Courtyard(), 0.10, 0.90);
 }
 
 TEST(EstimateRecordingTest, CourtyardCEveryBurstWithin5Percent) {
-  // Burst 1: E_sky red 5.1% high (the arcade wall, most of the shadow, 3.0% low in albedo).
-  // The 90th percentile: measured 5.6%, and no frame is over 10%: the confidence has nothing to
-  // rank (when one is, the issue's bar holds).
-  ExpectPerBurst(testing::CourtyardC(), {{1, 0.05, 0.065}}, 0.10, 0.90);
+  // Measured: worst 1.7% (burst 2's E_sun green), the 90th percentile 4.6%, and no frame is over
+  // 10%: the confidence has nothing to rank (when one is, the issue's bar holds).
+  ExpectPerBurst(testing::CourtyardC(), 0.10, 0.90);
 }
 
 TEST(EstimateRecordingTest, EveryDiffuseSurfaceInShadeIsSaidNotNaN) {
