@@ -176,7 +176,10 @@ class ChannelFitter {
   void Load(int c, bool split, double overcast, const std::vector<size_t>& rows) {
     m_ = rows.size();
     free_ = {with_sun_, true, split};
-    medians_ = FixedSubset(samples_, rows, stride_, false);
+    if (medians_rows_ != &rows || medians_.size() != rows.size()) {  // the same rows for each channel
+      medians_ = FixedSubset(samples_, rows, stride_, false);
+      medians_rows_ = &rows;
+    }
     for (size_t k = 0; k < m_; ++k) {
       const Sample& s = samples_[rows[k]];
       const double a = s.albedo[c] * glm::one_over_pi<double>();
@@ -266,6 +269,7 @@ class ChannelFitter {
   size_t m_ = 0;
   std::array<bool, 3> free_{};
   std::vector<uint8_t> medians_;  // of the loaded rows, those the medians read
+  const std::vector<size_t>* medians_rows_ = nullptr;  // the rows medians_ was made for
   double floor_ = 0.0;
   bool converged_ = false;
 };

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
+#include <string_view>
 #include <set>
 #include <vector>
 
@@ -106,6 +108,48 @@ void AddRunFigures(const nlohmann::json& json, const std::string& prefix, const 
   }
 }
 
+nlohmann::json ParseMeasuredJson(const std::string& text, const std::string& source) {
+  // Outside strings (a scan that follows quotes and their escapes), the words NaN, nan, inf and
+  // Infinity, with or without a minus, become null.
+  std::string cleaned;
+  cleaned.reserve(text.size());
+  bool in_string = false;
+  for (size_t i = 0; i < text.size();) {
+    const char c = text[i];
+    if (in_string) {
+      cleaned += c;
+      if (c == '\\' && i + 1 < text.size()) {
+        cleaned += text[i + 1];
+        i += 2;
+        continue;
+      }
+      in_string = c != '"';
+      ++i;
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+      cleaned += c;
+      ++i;
+      continue;
+    }
+    const size_t start = i + (c == '-' ? 1 : 0);
+    bool replaced = false;
+    for (const std::string_view word : {"Infinity", "NaN", "nan", "inf"}) {
+      if (text.compare(start, word.size(), word) == 0) {
+        cleaned += "null";
+        i = start + word.size();
+        replaced = true;
+        break;
+      }
+    }
+    if (!replaced) cleaned += c, ++i;
+  }
+  nlohmann::json json = nlohmann::json::parse(cleaned, nullptr, /*allow_exceptions=*/false);
+  if (json.is_discarded()) ThrowInputError("{}: not JSON", source);
+  return json;
+}
+
 MeasuredFigures LoadMeasuredFigures(const std::filesystem::path& folder) {
   if (!std::filesystem::is_directory(folder)) ThrowInputError("{}: not a folder of measured figures", folder.string());
   std::vector<std::filesystem::path> files;
@@ -120,8 +164,8 @@ MeasuredFigures LoadMeasuredFigures(const std::filesystem::path& folder) {
   std::sort(files.begin(), files.end());
   for (const std::filesystem::path& file : files) {
     std::ifstream in(file);
-    nlohmann::json json = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-    if (json.is_discarded()) ThrowInputError("{}: not JSON", file.string());
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const nlohmann::json json = ParseMeasuredJson(text, file.string());
     if (json.contains("benchmarks")) {
       AddBenchmarkFigures(json, file.string(), &figures);
     } else if (json.contains("testsuites")) {

@@ -42,6 +42,12 @@ void AddTestFigures(const nlohmann::json& json, const std::string& source, Measu
 void AddRunFigures(const nlohmann::json& json, const std::string& prefix, const std::string& source,
                    MeasuredFigures* figures);
 
+// The JSON `text` of a measured file (`source` names it in errors; a file that is not JSON is an
+// InputError). Google Benchmark writes NaN and inf, which JSON has not, for a counter's coefficient
+// of variation when the counter is always 0 (serve_bench's `dropped`): those read as null, and a
+// null counter is no figure.
+nlohmann::json ParseMeasuredJson(const std::string& text, const std::string& source);
+
 // Every *.json under `folder`, each by what it is: Google Benchmark's output, gtest's, or a
 // figures object under the prefix of its path ("courtyard-a/replay/figures.json" and
 // "courtyard-a/replay.json" both give courtyard-a/replay/<key>); and every *.csv as a table.

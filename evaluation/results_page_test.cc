@@ -59,6 +59,22 @@ TEST(ResultsPage, MediansOfRepetitionsInSeconds) {
   EXPECT_DOUBLE_EQ(figures.numbers.at("bench/BM_RenderFrame/8/real_time"), 17.0e-3);
 }
 
+// Google Benchmark's coefficient of variation of a counter that is always 0 is NaN, which JSON
+// has not (serve_bench's `dropped`): read as null, no figure; the run's other figures stay.
+TEST(ResultsPage, NotANumberFromGoogleBenchmarkIsNoFigure) {
+  const nlohmann::json json = ParseMeasuredJson(R"({"benchmarks": [
+    {"name": "BM_ServeFrame/0/real_time_median", "run_name": "BM_ServeFrame/0/real_time", "run_type": "aggregate",
+     "aggregate_name": "median", "real_time": 9.0, "time_unit": "us", "dropped": NaN, "worst": -inf,
+     "note": "ratio: NaN, kept"}]})", "serve_bench.json");
+  MeasuredFigures figures;
+  AddBenchmarkFigures(json, "serve_bench.json", &figures);
+  EXPECT_DOUBLE_EQ(figures.numbers.at("bench/BM_ServeFrame/0/real_time"), 9.0e-6);
+  EXPECT_EQ(figures.numbers.count("bench/BM_ServeFrame/0/dropped"), 0u);
+  EXPECT_EQ(figures.numbers.count("bench/BM_ServeFrame/0/worst"), 0u);
+  EXPECT_EQ(json["benchmarks"][0]["note"], "ratio: NaN, kept");  // a text is left as it is
+  EXPECT_THROW(ParseMeasuredJson("{\"a\": }", "broken.json"), InputError);
+}
+
 TEST(ResultsPage, FillsFieldsInTheirUnits) {
   const std::string page = FillResultsPage(
       "| frame | {{bench/BM_EstimateFrame/real_time|ms}} ms |\n"
