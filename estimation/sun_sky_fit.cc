@@ -107,23 +107,23 @@ uint32_t PixelHash(uint32_t x) {
   return x;
 }
 
-// Which of `rows` fall in a fixed share of the samples, 1 in `stride` (by the hash's low bits) or,
-// with `half`, one in two (by a high bit): chosen by each sample's camera pixel, not by its place in
-// the list. A sample that comes or goes as the sun moves then leaves every other one where it was;
-// by place (every other sample), each later one changed sides, and the sky's split into its clear
-// and overcast parts, which the half decides, moved E_sky by up to 2% for one sample in 8 000.
+// For each sample, whether it falls in a fixed share of them, 1 in `stride` (by the hash's low bits)
+// or, with `half`, one in two (by a high bit): chosen by its camera pixel, not by its place in the
+// list. A sample that comes or goes as the sun moves then leaves every other one where it was; by
+// place (every other sample), each later one changed sides, and the sky's split into its clear and
+// overcast parts, which the half decides, moved E_sky by up to 2% for one sample in 8 000.
 // Samples without distinct pixels (made by hand) fall back to their place.
-std::vector<uint8_t> FixedSubset(const std::vector<Sample>& samples, const std::vector<size_t>& rows, size_t stride, bool half) {
-  std::vector<uint8_t> in(rows.size());
+std::vector<uint8_t> FixedSubset(const std::vector<Sample>& samples, size_t stride, bool half) {
+  std::vector<uint8_t> in(samples.size());
   size_t count = 0;
-  for (size_t k = 0; k < rows.size(); ++k) {
-    const uint32_t h = PixelHash(samples[rows[k]].pixel);
-    in[k] = half ? (h >> 31) == 0 : h % stride == 0;
-    count += in[k];
+  for (size_t i = 0; i < samples.size(); ++i) {
+    const uint32_t h = PixelHash(samples[i].pixel);
+    in[i] = half ? (h >> 31) == 0 : h % stride == 0;
+    count += in[i];
   }
-  const size_t share = half ? 2 : stride, expected = rows.size() / share;
+  const size_t share = half ? 2 : stride, expected = samples.size() / share;
   if (share > 1 && (2 * count < expected || 2 * count > 3 * expected + 2)) {
-    for (size_t k = 0; k < rows.size(); ++k) in[k] = k % share == 0;
+    for (size_t i = 0; i < samples.size(); ++i) in[i] = i % share == 0;
   }
   return in;
 }
@@ -135,16 +135,13 @@ class ChannelFitter {
   ChannelFitter(const SunSkyFitOptions& options, const std::vector<Sample>& samples, size_t count, bool with_sun)
       : options_(options), samples_(samples), with_sun_(with_sun), y_(count), w_(count), relative_(count), offset_(count), rest_(count),
         x_{std::vector<double>(count), std::vector<double>(count), std::vector<double>(count)},
-        stride_(std::max<size_t>(1, count / 2000)) {
+        medians_(FixedSubset(samples, std::max<size_t>(1, count / 2000), false)), row_in_medians_(count) {
     scratch_.reserve(count);
   }
 
-  // Medians (start, floor, spread) are taken over one sample in stride() (FixedSubset): ~2000 of
-  // them give each to well under 1% and cost a quarter of the time.
-  size_t stride() const { return stride_; }
-  const std::vector<Sample>& samples() const { return samples_; }
-  // Whether the k-th of the last Fit's rows is among those medians' samples (FixedSubset).
-  bool InMedians(size_t k) const { return medians_[k] != 0; }
+  // Medians (start, floor, spread) are taken over a fixed ~2000 of the samples (FixedSubset): they
+  // give each to well under 1% and cost a quarter of the time. Whether sample i is one of them:
+  bool InMedians(size_t i) const { return medians_[i] != 0; }
   // After Fit: the samples' residuals relative to the prediction, in the order of `rows`.
   const std::vector<double>& relative() const { return relative_; }
   bool converged() const { return converged_; }
@@ -176,12 +173,9 @@ class ChannelFitter {
   void Load(int c, bool split, double overcast, const std::vector<size_t>& rows) {
     m_ = rows.size();
     free_ = {with_sun_, true, split};
-    if (medians_rows_ != &rows || medians_.size() != rows.size()) {  // the same rows for each channel
-      medians_ = FixedSubset(samples_, rows, stride_, false);
-      medians_rows_ = &rows;
-    }
     for (size_t k = 0; k < m_; ++k) {
       const Sample& s = samples_[rows[k]];
+      row_in_medians_[k] = medians_[rows[k]];
       const double a = s.albedo[c] * glm::one_over_pi<double>();
       y_[k] = s.radiance[c];
       x_[0][k] = a * s.sun[c];
@@ -213,7 +207,7 @@ class ChannelFitter {
     ChannelFit fit{0.0, 0.0, 0.0};
     scratch_.clear();
     for (size_t k = 0; k < m_; ++k) {
-      if (medians_[k] && !samples_[rows[k]].sunlit && x_[1][k] > 0.0) scratch_.push_back(rest_[k] / x_[1][k]);
+      if (row_in_medians_[k] && !samples_[rows[k]].sunlit && x_[1][k] > 0.0) scratch_.push_back(rest_[k] / x_[1][k]);
     }
     fit[1] = MedianInPlace(scratch_, 0.0);
     if (scratch_.empty()) {
@@ -222,7 +216,9 @@ class ChannelFitter {
     }
     scratch_.clear();
     for (size_t k = 0; k < m_; ++k) {
-      if (medians_[k] && IsSunlit(samples_[rows[k]], options_)) scratch_.push_back((rest_[k] - x_[1][k] * fit[1]) / x_[0][k]);
+      if (row_in_medians_[k] && IsSunlit(samples_[rows[k]], options_)) {
+        scratch_.push_back((rest_[k] - x_[1][k] * fit[1]) / x_[0][k]);
+      }
     }
     if (with_sun_ && !scratch_.empty()) fit[0] = std::max(0.0, MedianInPlace(scratch_, 0.0));
     return fit;
@@ -235,7 +231,7 @@ class ChannelFitter {
   ChannelFit Reweight(ChannelFit fit, bool split) {
     scratch_.clear();
     for (size_t k = 0; k < m_; ++k) {
-      if (medians_[k]) scratch_.push_back(Predict(fit, k));
+      if (row_in_medians_[k]) scratch_.push_back(Predict(fit, k));
     }
     floor_ = std::max(1e-12, 0.1 * MedianInPlace(scratch_, 0.0));
     const double inv_scale = 1.0 / options_.cauchy_scale;
@@ -265,11 +261,10 @@ class ChannelFitter {
   const bool with_sun_;
   std::vector<double> y_, w_, relative_, scratch_, offset_, rest_;  // rest_: y_ less offset_
   std::array<std::vector<double>, 3> x_;
-  const size_t stride_;
   size_t m_ = 0;
   std::array<bool, 3> free_{};
-  std::vector<uint8_t> medians_;  // of the loaded rows, those the medians read
-  const std::vector<size_t>* medians_rows_ = nullptr;  // the rows medians_ was made for
+  const std::vector<uint8_t> medians_;  // per sample: one the medians read
+  std::vector<uint8_t> row_in_medians_;  // the same per loaded row
   double floor_ = 0.0;
   bool converged_ = false;
 };
@@ -278,11 +273,12 @@ class ChannelFitter {
 // per channel on half the samples, then pooled (the mean over the channels). Per-channel parts let
 // a small model error in one channel trade sun for sky there. Also returns each channel's split
 // fit in `split_fits`.
-double PooledOvercast(ChannelFitter* fitter, const std::vector<size_t>& usable, std::array<ChannelFit, 3>* split_fits) {
+double PooledOvercast(ChannelFitter* fitter, const std::vector<Sample>& samples, const std::vector<size_t>& usable,
+                      std::array<ChannelFit, 3>* split_fits) {
+  const std::vector<uint8_t> half = FixedSubset(samples, 2, true);
   std::vector<size_t> every_other;
-  const std::vector<uint8_t> half = FixedSubset(fitter->samples(), usable, 2, true);
-  for (size_t k = 0; k < usable.size(); ++k) {
-    if (half[k]) every_other.push_back(usable[k]);
+  for (const size_t i : usable) {
+    if (half[i]) every_other.push_back(i);
   }
   double overcast = 0.0;
   for (int c = 0; c < 3; ++c) {
@@ -373,7 +369,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   for (const size_t i : usable) two_skies = two_skies || (options.split_sky && samples[i].sky != samples[i].overcast);
   ChannelFitter fitter(options, samples, n, with_sun);
   std::array<ChannelFit, 3> split_fits{};
-  const double overcast = two_skies ? PooledOvercast(&fitter, usable, &split_fits) : 0.0;
+  const double overcast = two_skies ? PooledOvercast(&fitter, samples, usable, &split_fits) : 0.0;
   // Each channel fitted again with the pooled overcast part given, starting from its split fit's
   // sun and clear sky.
   int unconverged_channels = 0;  // final fits that ran out of IRLS iterations
@@ -389,7 +385,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
     scratch.clear();
     for (size_t k = 0; k < n; ++k) {
       all_residuals.push_back(std::abs(fitter.relative()[k]));
-      if (fitter.InMedians(k)) scratch.push_back(std::abs(fitter.relative()[k]));
+      if (fitter.InMedians(usable[k])) scratch.push_back(std::abs(fitter.relative()[k]));
     }
     spreads.push_back(1.4826 * MedianInPlace(scratch, 0.0));
   }

@@ -42,13 +42,17 @@ void PrintTo(const Perturbation& p, std::ostream* os) {
   *os << fmt::format("{} north {:+g} deg clock {:+g} s", p.recording, p.north_deg, p.clock_s);
 }
 
+// A recording's name as a test name allows it: "courtyard-a" -> "courtyarda".
+std::string TestNameOf(std::string recording) {
+  recording.erase(std::remove(recording.begin(), recording.end(), '-'), recording.end());
+  return recording;
+}
+
 std::string Name(const ::testing::TestParamInfo<Perturbation>& info) {
   const auto signed_name = [](double v, const char* unit) {
     return fmt::format("{}{}{}", v < 0.0 ? "minus" : "plus", static_cast<int>(std::abs(v)), unit);
   };
-  std::string recording = info.param.recording;
-  recording.erase(std::remove(recording.begin(), recording.end(), '-'), recording.end());
-  return fmt::format("{}_north_{}_clock_{}", recording, signed_name(info.param.north_deg, "deg"),
+  return fmt::format("{}_north_{}_clock_{}", TestNameOf(info.param.recording), signed_name(info.param.north_deg, "deg"),
                      signed_name(info.param.clock_s, "s"));
 }
 
@@ -289,7 +293,8 @@ TEST_P(CalibrateLiveTest, WhatLiveAppliesIsWithinTheBarOrNorthIsKeptAndSaid) {
   const CsvTable estimates = ReadCsvFile(dir / "out" / "estimates.csv");
   ASSERT_FALSE(estimates.rows.empty());
   const std::string first_time = estimates.rows[0][static_cast<size_t>(estimates.RequireColumn("time_utc"))];
-  const std::string burst_start = fmt::format("{}T{}", std::string(c.fake_time).substr(0, 10), std::string(c.fake_time).substr(11, 4));
+  const std::string fake_time = c.fake_time;  // "YYYY-MM-DD hh:mm:ss": the frames' times start "YYYY-MM-DDThh:m"
+  const std::string burst_start = fake_time.substr(0, 10) + "T" + fake_time.substr(11, 4);
   EXPECT_EQ(first_time.rfind(burst_start, 0), 0u) << first_time;
   const size_t applied = run.err.find("--calibrate: north ");
   const size_t kept = run.err.find("constrain north only to ±");
@@ -311,11 +316,7 @@ TEST_P(CalibrateLiveTest, WhatLiveAppliesIsWithinTheBarOrNorthIsKeptAndSaid) {
 INSTANTIATE_TEST_SUITE_P(FirstBurst, CalibrateLiveTest,
                          ::testing::Values(LiveCase{"courtyard-c", "2026-06-21 13:20:03", true},
                                            LiveCase{"courtyard-a", "2026-06-21 05:00:03", false}),
-                         [](const ::testing::TestParamInfo<LiveCase>& param) {
-                           std::string name = param.param.recording;
-                           name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
-                           return name;
-                         });
+                         [](const ::testing::TestParamInfo<LiveCase>& param) { return TestNameOf(param.param.recording); });
 
 }  // namespace
 }  // namespace daylit

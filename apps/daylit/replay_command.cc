@@ -191,8 +191,8 @@ scene::Scene CalibrateOnTheCamera(const scene::Scene& scene, const bake::SceneBa
              "{} shadow-edge pixels ({:.1f}% on the wrong side before, {:.1f}% after); the clock held (one time of day); "
              "write \"north_azimuth_deg\": {:.3f} into {} to keep it",
              scene.north_azimuth_deg, calibrated.north_azimuth_deg, fit.north_offset_deg, fit.north_sigma_deg, fit.frames,
-             stretch.first_frame, stretch.last_frame, fit.edge_pixels, 100.0 * fit.disagree_before, 100.0 * fit.disagree_after, calibrated.north_azimuth_deg,
-             scene.file.string());
+             stretch.first_frame, stretch.last_frame, fit.edge_pixels, 100.0 * fit.disagree_before,
+             100.0 * fit.disagree_after, calibrated.north_azimuth_deg, scene.file.string());
   return calibrated;
 }
 
