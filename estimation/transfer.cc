@@ -69,10 +69,9 @@ void LightTransfer::Trace(const std::vector<uint32_t>& pixels) {
     fresh.push_back(p);
   }
   if (fresh.empty()) return;
-  std::vector<TracedPixel> traced(fresh.size());
-  TraceHemispheres(fresh, &traced);
-  TraceCells(&traced);
-  StorePaths(fresh, traced);
+  const size_t first_block = blocks_.size();
+  TraceHemispheres(fresh);
+  TraceCells(first_block);
 }
 
 // Albedo and V of a bounce point: the env maps' where the capture point sees it; else the
@@ -95,45 +94,77 @@ LightTransfer::Bounce LightTransfer::BounceAt(const glm::vec3& y, const scene::R
   return b;
 }
 
-void LightTransfer::TraceHemispheres(const std::vector<uint32_t>& fresh, std::vector<TracedPixel>* traced) const {
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, fresh.size(), kGrain), [&](const tbb::blocked_range<size_t>& range) {
-    thread_local std::vector<glm::vec3> dirs;
+// Each block of kBlockPixels fresh pixels on one thread: its rays into that thread's scratch
+// lists, then into the block's own, sized once. The store grows by blocks, so what earlier sun
+// moves traced is never copied again.
+void LightTransfer::TraceHemispheres(const std::vector<uint32_t>& fresh) {
+  const size_t first_block = blocks_.size(), first_path = paths_.size();
+  const size_t blocks = (fresh.size() + kBlockPixels - 1) / kBlockPixels;
+  blocks_.resize(first_block + blocks);
+  paths_.resize(first_path + fresh.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, blocks, 1), [&](const tbb::blocked_range<size_t>& range) {
+    thread_local std::vector<glm::vec3> dirs, low_sky, blocked;
     thread_local std::vector<scene::RayHit> hits;
+    thread_local std::vector<Bounce> bounces;
     for (size_t k = range.begin(); k != range.end(); ++k) {
-      const uint32_t p = fresh[k];
-      TracedPixel& pixel = (*traced)[k];
-      const glm::vec3 origin = points_.point[p] + options_.offset_m * points_.normal[p];
-      const glm::mat3 frame = bake::HemisphereFrame(points_.normal[p], p);
-      dirs.resize(hemisphere_.size()), hits.resize(hemisphere_.size());
-      for (size_t r = 0; r < dirs.size(); ++r) dirs[r] = frame * hemisphere_[r];
-      caster_.IntersectFrom(origin, dirs.data(), dirs.size(), 0.0f, hits.data());
-      size_t low_sky = 0, blocked = 0, bounces = 0;  // sized once
-      for (size_t r = 0; r < dirs.size(); ++r) {
-        low_sky += !hits[r].IsHit() && dirs[r].z <= 0.0f, blocked += hits[r].IsHit() && dirs[r].z > 0.0f;
-        bounces += hits[r].IsHit() && options_.interreflection;
-      }
-      pixel.low_sky.reserve(low_sky), pixel.blocked.reserve(blocked), pixel.bounces.reserve(bounces);
-      for (size_t r = 0; r < dirs.size(); ++r) {
-        const glm::vec3& dir = dirs[r];
-        const scene::RayHit& hit = hits[r];
-        if (!hit.IsHit()) {
-          if (dir.z <= 0.0f) pixel.low_sky.push_back(dir);
-          continue;
+      low_sky.clear(), blocked.clear(), bounces.clear();
+      const uint32_t block = static_cast<uint32_t>(first_block + k);
+      for (size_t f = k * kBlockPixels; f < std::min(fresh.size(), (k + 1) * kBlockPixels); ++f) {
+        const uint32_t p = fresh[f];
+        Paths& paths = paths_[first_path + f];
+        paths.block = block;
+        paths.low_sky_begin = static_cast<uint32_t>(low_sky.size());
+        paths.blocked_begin = static_cast<uint32_t>(blocked.size());
+        paths.bounce_begin = static_cast<uint32_t>(bounces.size());
+        const glm::vec3 origin = points_.point[p] + options_.offset_m * points_.normal[p];
+        const glm::mat3 frame = bake::HemisphereFrame(points_.normal[p], p);
+        dirs.resize(hemisphere_.size()), hits.resize(hemisphere_.size());
+        for (size_t r = 0; r < dirs.size(); ++r) dirs[r] = frame * hemisphere_[r];
+        caster_.IntersectFrom(origin, dirs.data(), dirs.size(), 0.0f, hits.data());
+        for (size_t r = 0; r < dirs.size(); ++r) {
+          const glm::vec3& dir = dirs[r];
+          const scene::RayHit& hit = hits[r];
+          if (!hit.IsHit()) {
+            if (dir.z <= 0.0f) low_sky.push_back(dir);
+            continue;
+          }
+          if (dir.z > 0.0f) blocked.push_back(dir);
+          if (options_.interreflection) {
+            bounces.push_back(BounceAt(origin + hit.t * dir, hit));
+            bounces.back().orientation = OrientationKey(hit.normal);  // made an index below
+          }
         }
-        if (dir.z > 0.0f) pixel.blocked.push_back(dir);
-        if (options_.interreflection) pixel.bounces.push_back(BounceAt(origin + hit.t * dir, hit));
+        paths.low_sky_end = static_cast<uint32_t>(low_sky.size());
+        paths.blocked_end = static_cast<uint32_t>(blocked.size());
+        paths.bounce_end = static_cast<uint32_t>(bounces.size());
       }
+      PathBlock& out = blocks_[block];
+      out.low_sky.assign(low_sky.begin(), low_sky.end());
+      out.blocked.assign(blocked.begin(), blocked.end());
+      out.bounces.assign(bounces.begin(), bounces.end());
     }
   });
+  // The tables shared by all blocks grow here, in order.
+  uint32_t last_key = UINT32_MAX, last_index = 0;  // neighbouring hits mostly share a plane
+  for (size_t k = first_block; k < blocks_.size(); ++k) {
+    for (Bounce& b : blocks_[k].bounces) {
+      if (b.orientation != last_key) last_key = b.orientation, last_index = OrientationOfKey(last_key);
+      b.orientation = last_index;
+    }
+  }
+  for (size_t f = 0; f < fresh.size(); ++f) {
+    paths_[first_path + f].orientation = OrientationOf(points_.normal[fresh[f]]);
+    slot_[fresh[f]] = static_cast<int32_t>(first_path + f);
+  }
 }
 
 // The cells of the points' bounce points, and theirs in turn down to the level the bounces need
 // (level L's hits get cells while L < bounces − 1; level 1 is always traced, for V). A cell first
 // met deeper and later by a point keeps its trace and gets its hits' cells then.
-void LightTransfer::TraceCells(std::vector<TracedPixel>* traced) {
+void LightTransfer::TraceCells(size_t first_block) {
   const uint32_t deepest = static_cast<uint32_t>(std::max(1, options_.bounces - 1));
-  for (TracedPixel& pixel : *traced) {
-    for (Bounce& b : pixel.bounces) b.cell = CellFor(b, 1);
+  for (size_t k = first_block; k < blocks_.size(); ++k) {
+    for (Bounce& b : blocks_[k].bounces) b.cell = CellFor(b, 1);
   }
   for (uint32_t depth = 1; depth <= deepest; ++depth) {
     std::vector<uint32_t> untraced, unexpanded;
@@ -150,11 +181,11 @@ void LightTransfer::TraceCells(std::vector<TracedPixel>* traced) {
       }
     }
   }
-  FillHiddenSkyVisibility(traced);
+  FillHiddenSkyVisibility(first_block);
 }
 
 uint32_t LightTransfer::CellFor(const Bounce& b, uint32_t level) {
-  const auto [it, inserted] = cell_of_.emplace(CellKey(b, std::min(level, 2u)), static_cast<uint32_t>(cells_.size()));
+  const auto [it, inserted] = cell_of_.try_emplace(CellKey(b, std::min(level, 2u)), static_cast<uint32_t>(cells_.size()));
   if (inserted) {
     cells_.push_back({bake::SurfaceCellOrigin(b.point, b.normal, CellEdge(level)), b.normal, level});
   } else if (cells_[it->second].level > level) {
@@ -177,24 +208,33 @@ void LightTransfer::TraceNewCells(const std::vector<uint32_t>& cells) {
       dirs.resize(hemisphere.size()), ray_hits.resize(hemisphere.size());
       for (size_t r = 0; r < dirs.size(); ++r) dirs[r] = frame * hemisphere[r];
       caster_.IntersectFrom(cell.origin, dirs.data(), dirs.size(), 0.0f, ray_hits.data());
-      int open = 0;
+      size_t open = 0;
+      for (size_t r = 0; r < dirs.size(); ++r) open += !ray_hits[r].IsHit();
+      open_dirs[i].reserve(open), hits[i].reserve(options_.interreflection ? dirs.size() - open : 0);
       for (size_t r = 0; r < dirs.size(); ++r) {
         if (!ray_hits[r].IsHit()) {
-          ++open;
           open_dirs[i].push_back(PackDirection(dirs[r]));
         } else if (options_.interreflection) {
           hits[i].push_back(BounceAt(cell.origin + ray_hits[r].t * dirs[r], ray_hits[r]));
+          hits[i].back().orientation = OrientationKey(ray_hits[r].normal);  // made an index below
         }
       }
       cell.sky_visibility = static_cast<float>(open) / static_cast<float>(dirs.size());
     }
   });
+  size_t bounces = cell_bounces_.size(), sky = cell_sky_.size();
+  for (size_t i = 0; i < cells.size(); ++i) bounces += hits[i].size(), sky += open_dirs[i].size();
+  // Grown by half at least: each depth of a trace appends, and a move copies all before it.
+  if (bounces > cell_bounces_.capacity()) cell_bounces_.reserve(bounces + bounces / 2);
+  if (sky > cell_sky_.capacity()) cell_sky_.reserve(sky + sky / 2);
+  uint32_t last_key = UINT32_MAX, last_index = 0;  // a cell's hits mostly share a plane
   for (size_t i = 0; i < cells.size(); ++i) {
     Cell& cell = cells_[cells[i]];
     cell.traced = true;
     cell.bounce_begin = static_cast<uint32_t>(cell_bounces_.size());
     for (Bounce b : hits[i]) {
-      b.orientation = OrientationOf(b.normal);
+      if (b.orientation != last_key) last_key = b.orientation, last_index = OrientationOfKey(last_key);
+      b.orientation = last_index;
       cell_bounces_.push_back(b);
     }
     cell.bounce_end = static_cast<uint32_t>(cell_bounces_.size());
@@ -207,9 +247,9 @@ void LightTransfer::TraceNewCells(const std::vector<uint32_t>& cells) {
 // V of the bounce points the capture point does not see (~5% of them on courtyard-a): their
 // cell's (V is smooth). Hits of the deepest cells have no cell of their own: a traced cell of their
 // square if there is one, else the mean V of their surface's cells.
-void LightTransfer::FillHiddenSkyVisibility(std::vector<TracedPixel>* traced) {
-  for (TracedPixel& pixel : *traced) {
-    for (Bounce& b : pixel.bounces) {
+void LightTransfer::FillHiddenSkyVisibility(size_t first_block) {
+  for (size_t k = first_block; k < blocks_.size(); ++k) {
+    for (Bounce& b : blocks_[k].bounces) {
       if (b.sky_visibility < 0.0f) b.sky_visibility = cells_[b.cell].sky_visibility;
     }
   }
@@ -236,47 +276,6 @@ void LightTransfer::FillHiddenSkyVisibility(std::vector<TracedPixel>* traced) {
     const auto it = by_surface.find(b.surface);
     b.sky_visibility = it == by_surface.end() ? 0.5f : static_cast<float>(it->second.first / it->second.second);
   }
-}
-
-// Serial only where the shared tables grow (each range's offsets, the ids of new orientations);
-// the copies, a hundred MB or more when the sun moves to a new burst, run in parallel.
-void LightTransfer::StorePaths(const std::vector<uint32_t>& fresh, const std::vector<TracedPixel>& traced) {
-  const size_t n = fresh.size(), first_bounce = bounces_.size();
-  std::vector<Paths> paths(n);
-  size_t low = low_sky_.size(), blocked = blocked_.size(), bounces = first_bounce;
-  for (size_t k = 0; k < n; ++k) {
-    Paths& p = paths[k];
-    p.low_sky_begin = static_cast<uint32_t>(low), p.low_sky_end = static_cast<uint32_t>(low += traced[k].low_sky.size());
-    p.blocked_begin = static_cast<uint32_t>(blocked), p.blocked_end = static_cast<uint32_t>(blocked += traced[k].blocked.size());
-    p.bounce_begin = static_cast<uint32_t>(bounces), p.bounce_end = static_cast<uint32_t>(bounces += traced[k].bounces.size());
-  }
-  // Room for what later sun moves add (a fifth of the first trace each, on the recordings): a
-  // vector that grows copies everything it holds, page by fresh page.
-  if (bounces > bounces_.capacity()) bounces_.reserve(2 * bounces);
-  low_sky_.resize(low), blocked_.resize(blocked), bounces_.resize(bounces);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kGrain), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t k = range.begin(); k != range.end(); ++k) {
-      const TracedPixel& pixel = traced[k];
-      std::copy(pixel.low_sky.begin(), pixel.low_sky.end(), low_sky_.begin() + paths[k].low_sky_begin);
-      std::copy(pixel.blocked.begin(), pixel.blocked.end(), blocked_.begin() + paths[k].blocked_begin);
-      Bounce* out = bounces_.data() + paths[k].bounce_begin;
-      for (const Bounce& b : pixel.bounces) {
-        *out = b;
-        (out++)->orientation = OrientationKey(b.normal);  // made an index below
-      }
-    }
-  });
-  uint32_t last_key = UINT32_MAX, last_index = 0;  // neighbouring hits mostly share a plane
-  for (size_t i = first_bounce; i < bounces_.size(); ++i) {
-    const uint32_t key = bounces_[i].orientation;
-    if (key != last_key) last_key = key, last_index = OrientationOfKey(key);
-    bounces_[i].orientation = last_index;
-  }
-  for (size_t k = 0; k < n; ++k) {
-    paths[k].orientation = OrientationOf(points_.normal[fresh[k]]);
-    slot_[fresh[k]] = static_cast<int32_t>(paths_.size() + k);
-  }
-  paths_.insert(paths_.end(), paths.begin(), paths.end());
 }
 
 float LightTransfer::CellEdge(uint32_t level) { return level == 1 ? kCellSize : kDeepCellScale * kCellSize; }
@@ -390,9 +389,10 @@ Transfer LightTransfer::DirectReflected(const Bounce& b, float sun_cos, const Cl
 
 // Jacobi iteration from no reflected light: after k passes a cell holds what reaches it over k
 // bounces, so bounces − 1 passes give the points their full count.
-std::vector<Transfer> LightTransfer::SolveCells(const glm::vec3& sun_dir, const ClearSky& sky) const {
+std::vector<Transfer> LightTransfer::SolveCells(const glm::vec3& sun_dir, const ClearSky& sky) {
   const bool day = sun_dir.z > 0.0f;
-  std::vector<Transfer> own(cell_bounces_.size());  // each hit's reflected direct light
+  std::vector<Transfer>& own = own_;  // each hit's reflected direct light; every one is written below
+  own.resize(cell_bounces_.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, cells_.size(), 16), [&](const tbb::blocked_range<size_t>& range) {
     thread_local std::vector<glm::vec3> origins;
     thread_local std::vector<uint32_t> facing;
@@ -470,19 +470,20 @@ void LightTransfer::DirectAndReflected(const std::vector<uint32_t>& pixels, cons
     for (size_t k = range.begin(); k != range.end(); ++k) {
       const uint32_t p = pixels[k];
       const Paths& paths = paths_[static_cast<size_t>(slot_[p])];
+      const PathBlock& block = blocks_[paths.block];
       Transfer t, r;
       origins.clear(), facing.clear();
       for (uint32_t i = paths.bounce_begin; day && i < paths.bounce_end; ++i) {
-        if (glm::dot(bounces_[i].normal, sun_dir) > 0.0f) origins.push_back(bounces_[i].point), facing.push_back(i);
+        if (glm::dot(block.bounces[i].normal, sun_dir) > 0.0f) origins.push_back(block.bounces[i].point), facing.push_back(i);
       }
       occluded.resize(origins.size());
       caster_.OccludedAlong(origins.data(), origins.size(), sun_dir, 0.0f, occluded.data());
       for (size_t j = 0; j < facing.size(); ++j) {
-        const Bounce& b = bounces_[facing[j]];
+        const Bounce& b = block.bounces[facing[j]];
         if (!occluded[j]) r.sun += b.albedo * glm::dot(b.normal, sun_dir);
       }
       for (uint32_t i = paths.bounce_begin; i < paths.bounce_end; ++i) {
-        const Bounce& b = bounces_[i];
+        const Bounce& b = block.bounces[i];
         const Transfer own = DirectReflected(b, 0.0f, sky);
         const Transfer& further = cell_light[b.cell];
         r.clear += own.clear + b.albedo * further.clear, r.overcast += own.overcast + b.albedo * further.overcast;
@@ -499,8 +500,8 @@ void LightTransfer::DirectAndReflected(const std::vector<uint32_t>& pixels, cons
       t.clear = glm::vec3(v);
       if (sky.on) {
         glm::vec3 blocked(0.0f), low(0.0f);
-        for (uint32_t d = paths.blocked_begin; d < paths.blocked_end; ++d) blocked += sky_.Radiance(blocked_[d], sun_dir);
-        for (uint32_t d = paths.low_sky_begin; d < paths.low_sky_end; ++d) low += sky_.Radiance(low_sky_[d], sun_dir);
+        for (uint32_t d = paths.blocked_begin; d < paths.blocked_end; ++d) blocked += sky_.Radiance(block.blocked[d], sun_dir);
+        for (uint32_t d = paths.low_sky_begin; d < paths.low_sky_end; ++d) low += sky_.Radiance(block.low_sky[d], sun_dir);
         t.clear = glm::max(sky.open[paths.orientation].clear + (low - blocked) * glm::pi<float>() * sky.inv_dhi * inv_rays,
                            glm::vec3(0.0f));
       }

@@ -31,9 +31,7 @@
 
 #include <cstdint>
 #include <memory>
-#include <new>
 #include <string>
-#include <type_traits>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -121,24 +119,6 @@ class LightTransfer {
     uint32_t orientation;      // index into orientations_
     uint32_t cell;             // index into cells_ (kNoCell: none): where its own reflected light comes from
   };
-  // Trivial, so that growing bounces_ leaves the new elements for StorePaths' threads to write
-  // first (each fresh page faulted by one of them, not all of them by one thread).
-  static_assert(std::is_trivially_default_constructible_v<Bounce>);
-  template <typename T>
-  struct DefaultInitAllocator : std::allocator<T> {
-    template <typename U>
-    struct rebind {
-      using other = DefaultInitAllocator<U>;
-    };
-    template <typename U>
-    void construct(U* p) noexcept {
-      ::new (static_cast<void*>(p)) U;
-    }
-    template <typename U, typename... Args>
-    void construct(U* p, Args&&... args) {
-      ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-    }
-  };
   // A square of one side of a surface: the node of the radiosity solve.
   struct Cell {
     glm::vec3 origin;  // its centre dropped onto the plane of the bounce point that made it
@@ -152,19 +132,21 @@ class LightTransfer {
   };
   struct Paths {
     uint32_t orientation = 0;                     // of the pixel's normal
-    uint32_t low_sky_begin = 0, low_sky_end = 0;  // into low_sky_
-    uint32_t blocked_begin = 0, blocked_end = 0;  // into blocked_
-    uint32_t bounce_begin = 0, bounce_end = 0;    // into bounces_
+    uint32_t block = 0;                           // into blocks_; the ranges below are into its lists
+    uint32_t low_sky_begin = 0, low_sky_end = 0;
+    uint32_t blocked_begin = 0, blocked_end = 0;
+    uint32_t bounce_begin = 0, bounce_end = 0;
   };
+  // The paths of up to kBlockPixels pixels traced together, in one list per kind of ray.
+  struct PathBlock {
+    std::vector<glm::vec3> low_sky;  // rays that escape below the horizon
+    std::vector<glm::vec3> blocked;  // rays above the horizon that the model stops
+    std::vector<Bounce> bounces;     // their hits
+  };
+  static constexpr size_t kBlockPixels = 64;
   struct OpenSky {
     glm::vec3 clear{0.0f};  // ∫ (L_clear/DHI) max(0, n·ω) dω over the upper hemisphere
     float uniform = 0.0f;   // ∫ (1/π) max(0, n·ω) dω over the upper hemisphere
-  };
-  // One pixel's rays as traced, before they are stored in the flat arrays below.
-  struct TracedPixel {
-    std::vector<glm::vec3> low_sky;  // rays that escape below the horizon
-    std::vector<glm::vec3> blocked;  // rays above the horizon that the model stops
-    std::vector<Bounce> bounces;
   };
   // The clear sky under one sun, normalised to a unit DHI; off (uniform only) at night or
   // without a captured sky.
@@ -176,15 +158,14 @@ class LightTransfer {
   };
   // Traces the paths of the pixels not traced yet (Trace's steps follow).
   void Trace(const std::vector<uint32_t>& pixels);
-  void TraceHemispheres(const std::vector<uint32_t>& fresh, std::vector<TracedPixel>* traced) const;
+  void TraceHemispheres(const std::vector<uint32_t>& fresh);  // appends their blocks and paths
   Bounce BounceAt(const glm::vec3& y, const scene::RayHit& hit) const;
-  // Cells for the bounce points that have none (`level`: of the cells they get), traced with their
-  // hits' cells down to the level the bounces need; then V of every hidden bounce point.
-  void TraceCells(std::vector<TracedPixel>* traced);
+  // Cells for the bounce points of the blocks from `first_block` on, traced with their hits'
+  // cells down to the level the bounces need; then V of every hidden bounce point.
+  void TraceCells(size_t first_block);
   uint32_t CellFor(const Bounce& b, uint32_t level);  // finds or adds (untraced) its cell
   void TraceNewCells(const std::vector<uint32_t>& cells);
-  void FillHiddenSkyVisibility(std::vector<TracedPixel>* traced);
-  void StorePaths(const std::vector<uint32_t>& fresh, const std::vector<TracedPixel>& traced);
+  void FillHiddenSkyVisibility(size_t first_block);
   // Compute's steps: the direct terms and the first bounce per pixel, then the further bounces.
   ClearSky ClearSkyUnder(const glm::vec3& sun_dir) const;
   // What a bounce point reflects of its direct light per unit of each part: ρ_y times its direct
@@ -192,7 +173,7 @@ class LightTransfer {
   Transfer DirectReflected(const Bounce& b, float sun_cos, const ClearSky& sky) const;
   // Each cell's reflected irradiance (what reaches it from the cells it sees), iterated
   // bounces − 1 times.
-  std::vector<Transfer> SolveCells(const glm::vec3& sun_dir, const ClearSky& sky) const;
+  std::vector<Transfer> SolveCells(const glm::vec3& sun_dir, const ClearSky& sky);
   void DirectAndReflected(const std::vector<uint32_t>& pixels, const glm::vec3& sun_dir, const float* direct,
                           const ClearSky& sky, const std::vector<Transfer>& cell_light, Transfer* out,
                           Transfer* reflected) const;
@@ -214,14 +195,14 @@ class LightTransfer {
   std::vector<glm::vec3> hemisphere_;
   std::vector<int32_t> slot_;       // per G-buffer pixel: index into paths_, −1 until traced
   std::vector<Paths> paths_;
-  std::vector<glm::vec3> low_sky_, blocked_;
-  std::vector<Bounce, DefaultInitAllocator<Bounce>> bounces_;
+  std::vector<PathBlock> blocks_;
   std::vector<glm::vec3> orientations_;  // distinct normals of pixels and bounce points (to ~1°)
   std::unordered_map<uint32_t, uint32_t> orientation_of_;  // OrientationKey → index
   std::vector<Cell> cells_;
   std::vector<Bounce> cell_bounces_;              // the hits of each cell's rays
   std::vector<uint32_t> cell_sky_;                // the others' directions, packed
   std::unordered_map<uint64_t, uint32_t> cell_of_;  // CellKey -> index into cells_
+  std::vector<Transfer> own_;  // SolveCells' per hit, kept: 70 MB on courtyard-c, faulted in once, not per sun
 };
 
 }  // namespace daylit::estimation
