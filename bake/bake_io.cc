@@ -404,9 +404,11 @@ SceneBake BakeOrLoad(const scene::Scene& scene, const BakeOptions& options, cons
     ThrowInputError("{}: cannot create the cache folder: {}", dir.string(), ec ? ec.message() : "a file is in the way");
   }
   if (::access(dir.c_str(), W_OK) != 0) ThrowInputError("{}: the cache folder may not be written to", dir.string());
-  SceneBake bake = RunBake(scene, options);
-  SaveBake(bake, scene, options, dir);
-  return bake;
+  SaveBake(RunBake(scene, options), scene, options, dir);
+  // Read back: the run goes on with the bake as the cache holds it (normals, V and albedo in half
+  // floats), so that it and every later run from the cache give the same figures to the last digit.
+  if (std::optional<SceneBake> stored = LoadBake(dir, hash)) return std::move(*stored);
+  ThrowInputError("{}: the bake just written there cannot be read back", dir.string());
 }
 
 }  // namespace daylit::bake
