@@ -12,6 +12,8 @@ extern "C" {
 #include <cstdarg>
 #include <string>
 
+#include <opencv2/core/hal/hal.hpp>
+
 #include "base/error.h"
 #include "base/log.h"
 
@@ -163,36 +165,42 @@ void Yuv420ToRgb(const uint8_t* y, int y_stride, const uint8_t* u, int u_stride,
   const int cw = (width + 1) / 2, ch = (height + 1) / 2;
   // Chroma is upsampled bilinearly (left-sited horizontally, centred vertically). The matrix is
   // linear in Cb and Cr, so each row first gets the three chroma terms of the matrix at the
-  // chroma columns (interpolated vertically), and each pixel adds its luma to the terms at its
-  // column (interpolated horizontally: an even column sits on a chroma sample, an odd one halfway).
-  std::array<float, 256> luma_of{};
-  for (int code = 0; code < 256; ++code) luma_of[static_cast<size_t>(code)] = (static_cast<float>(code) - 16.0f) / 219.0f;
-  std::vector<float> r_term(static_cast<size_t>(cw) + 1), g_term(r_term.size()), b_term(r_term.size());
+  // chroma columns (interpolated vertically), then at every column (an even column sits on a
+  // chroma sample, an odd one halfway), then adds its luma per channel into planar rows, which
+  // OpenCV interleaves: every loop but the last runs on contiguous floats, which the compiler
+  // vectorises (a loop storing R, G, B in turn did not: 1.1 ms a 960×540 frame, a quarter of the
+  // decoder's time).
+  const size_t n = static_cast<size_t>(width), nc = static_cast<size_t>(cw);
+  std::vector<float> buffer(3 * (nc + 1) + 4 * n);
+  float* const term[3] = {buffer.data(), buffer.data() + nc + 1, buffer.data() + 2 * (nc + 1)};
+  float* const plane[3] = {buffer.data() + 3 * (nc + 1), buffer.data() + 3 * (nc + 1) + n, buffer.data() + 3 * (nc + 1) + 2 * n};
+  float* const luma = buffer.data() + 3 * (nc + 1) + 3 * n;
   for (int row = 0; row < height; ++row) {
     const float cy = std::clamp((static_cast<float>(row) - 0.5f) * 0.5f, 0.0f, static_cast<float>(ch - 1));
     const int y0 = static_cast<int>(cy), y1 = std::min(y0 + 1, ch - 1);
     const float fy = cy - static_cast<float>(y0);
     const uint8_t *u0 = u + y0 * u_stride, *u1 = u + y1 * u_stride, *v0 = v + y0 * v_stride, *v1 = v + y1 * v_stride;
-    for (int x = 0; x < cw; ++x) {
+    for (size_t x = 0; x < nc; ++x) {
       const float cb = ((1.0f - fy) * u0[x] + fy * u1[x] - 128.0f) / 224.0f;
       const float cr = ((1.0f - fy) * v0[x] + fy * v1[x] - 128.0f) / 224.0f;
-      r_term[static_cast<size_t>(x)] = r_cr * cr;
-      g_term[static_cast<size_t>(x)] = g_cb * cb + g_cr * cr;
-      b_term[static_cast<size_t>(x)] = b_cb * cb;
+      term[0][x] = r_cr * cr;
+      term[1][x] = g_cb * cb + g_cr * cr;
+      term[2][x] = b_cb * cb;
     }
-    // Past the last chroma column the last one repeats.
-    r_term[static_cast<size_t>(cw)] = r_term[static_cast<size_t>(cw) - 1];
-    g_term[static_cast<size_t>(cw)] = g_term[static_cast<size_t>(cw) - 1];
-    b_term[static_cast<size_t>(cw)] = b_term[static_cast<size_t>(cw) - 1];
-    const uint8_t* luma = y + row * y_stride;
-    float* out = rgb->ptr<float>(row);
-    for (int col = 0; col < width; ++col) {
-      const size_t x0 = static_cast<size_t>(col >> 1), x1 = x0 + static_cast<size_t>(col & 1);
-      const float l = luma_of[luma[col]];
-      out[3 * col + 0] = std::clamp(l + 0.5f * (r_term[x0] + r_term[x1]), 0.0f, 1.0f);
-      out[3 * col + 1] = std::clamp(l + 0.5f * (g_term[x0] + g_term[x1]), 0.0f, 1.0f);
-      out[3 * col + 2] = std::clamp(l + 0.5f * (b_term[x0] + b_term[x1]), 0.0f, 1.0f);
+    const uint8_t* codes = y + row * y_stride;
+    for (size_t col = 0; col < n; ++col) luma[col] = (static_cast<float>(codes[col]) - 16.0f) / 219.0f;
+    for (int c = 0; c < 3; ++c) {
+      float* t = term[c];
+      float* out = plane[c];
+      t[nc] = t[nc - 1];  // past the last chroma column the last one repeats
+      for (size_t x = 0; 2 * x < n; ++x) out[2 * x] = std::clamp(luma[2 * x] + t[x], 0.0f, 1.0f);
+      for (size_t x = 0; 2 * x + 1 < n; ++x) {
+        out[2 * x + 1] = std::clamp(luma[2 * x + 1] + 0.5f * (t[x] + t[x + 1]), 0.0f, 1.0f);
+      }
     }
+    const int* planes[3] = {reinterpret_cast<const int*>(plane[0]), reinterpret_cast<const int*>(plane[1]),
+                            reinterpret_cast<const int*>(plane[2])};
+    cv::hal::merge32s(planes, rgb->ptr<int>(row), width, 3);  // floats moved as 32-bit words
   }
 }
 
