@@ -33,20 +33,27 @@ constexpr float kRayOffsetM = 2e-3f;  // shadow rays start this far off the surf
 constexpr int kMinClearFrames = 3;     // a burst with fewer gives no σ
 constexpr size_t kMinSunlitPixels = 200;  // nor one whose σ shows less sun than this
 
-// How sunlit each diffuse pixel looks in `radiance` (interleaved RGB, radiance units) under the
-// frame's light: the irradiance π·L/ρ less the sky's share E_sky·V, over the sun's E_sun·cos.
-void SunlitFraction(const bake::CameraGBuffer& g, const std::vector<uint32_t>& diffuse, const std::vector<float>& radiance,
-                    double exposure, const estimation::SunSky& light, const glm::vec3& sun_dir, std::vector<float>* sigma) {
+// How sunlit each diffuse pixel of `frame` (of the G-buffer's size) looks under the frame's light:
+// the irradiance π·L/ρ less the sky's share E_sky·V, over the sun's E_sun·cos. Only the diffuse
+// pixels are linearized (as LinearRadiance would).
+void SunlitFraction(const bake::CameraGBuffer& g, const std::vector<uint32_t>& diffuse, const capture::Frame& frame,
+                    const capture::Linearizer& linearizer, const estimation::SunSky& light, const glm::vec3& sun_dir,
+                    std::vector<float>* sigma) {
   sigma->resize(diffuse.size());
   const glm::vec3 e_sun(light.sun_rgb), e_sky(light.sky_rgb);
   const float sun_sum = e_sun.x + e_sun.y + e_sun.z;
-  const float saturated = static_cast<float>(0.98 / exposure);
+  const float saturated = static_cast<float>(0.98 / frame.exposure);
+  const float scale = static_cast<float>(1.0 / frame.exposure);
+  const uint32_t width = static_cast<uint32_t>(g.width);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, diffuse.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t i = range.begin(); i != range.end(); ++i) {
       const uint32_t p = diffuse[i];
       const float c = glm::dot(g.normal[p], sun_dir);
       const glm::vec3 rho = g.albedo[p];
-      const glm::vec3 l(radiance[3 * p], radiance[3 * p + 1], radiance[3 * p + 2]);
+      const float* in = frame.rgb.ptr<float>(static_cast<int>(p / width)) + 3 * (p % width);
+      const glm::vec3 l = frame.linear ? glm::vec3(in[0] * scale, in[1] * scale, in[2] * scale)
+                                       : glm::vec3(linearizer(in[0], 0) * scale, linearizer(in[1], 1) * scale,
+                                                   linearizer(in[2], 2) * scale);
       if (c < 0.05f || rho.x < 0.02f || rho.y < 0.02f || rho.z < 0.02f || l.x >= saturated || l.y >= saturated ||
           l.z >= saturated) {
         (*sigma)[i] = kNoSigma;
@@ -315,8 +322,7 @@ void ShadowObserver::Add(const capture::Frame& frame, const estimation::FrameEst
   const bool full = static_cast<int>(kept_.size()) >= options_.frames_per_burst;
   if (full && weakest->sun_to_sky >= ratio) return;
   ClearFrame f{ratio, frame.utc, frame.index, {}};
-  capture::LinearRadiance(frame, linearizer_, &radiance_);
-  SunlitFraction(bake_.camera, diffuse_, radiance_, frame.exposure, row.light, SunWith(scene_, frame.utc, 0.0, 0.0), &f.sigma);
+  SunlitFraction(bake_.camera, diffuse_, frame, linearizer_, row.light, SunWith(scene_, frame.utc, 0.0, 0.0), &f.sigma);
   if (full) {
     *weakest = std::move(f);
   } else {

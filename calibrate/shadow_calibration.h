@@ -85,7 +85,6 @@ class ShadowObserver {
   capture::Linearizer linearizer_;
   std::vector<uint32_t> diffuse_;  // the G-buffer's diffuse pixels
   std::vector<ClearFrame> kept_;   // the burst's clearest frames so far, at most frames_per_burst
-  std::vector<float> radiance_;
   int first_ = 0, last_ = 0;
   std::optional<UtcTime> previous_;
   UtcTime start_;                  // the burst's (or stretch's) first frame
