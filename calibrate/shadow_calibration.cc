@@ -51,9 +51,9 @@ void SunlitFraction(const bake::CameraGBuffer& g, const std::vector<uint32_t>& d
       const float c = glm::dot(g.normal[p], sun_dir);
       const glm::vec3 rho = g.albedo[p];
       const float* in = frame.rgb.ptr<float>(static_cast<int>(p / width)) + 3 * (p % width);
-      const glm::vec3 l = frame.linear ? glm::vec3(in[0] * scale, in[1] * scale, in[2] * scale)
-                                       : glm::vec3(linearizer(in[0], 0) * scale, linearizer(in[1], 1) * scale,
-                                                   linearizer(in[2], 2) * scale);
+      float linear[3] = {in[0], in[1], in[2]};
+      if (!frame.linear) linearizer.Apply(in, linear, 3);
+      const glm::vec3 l = glm::vec3(linear[0], linear[1], linear[2]) * scale;
       if (c < 0.05f || rho.x < 0.02f || rho.y < 0.02f || rho.z < 0.02f || l.x >= saturated || l.y >= saturated ||
           l.z >= saturated) {
         (*sigma)[i] = kNoSigma;
