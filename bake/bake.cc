@@ -108,7 +108,7 @@ EnvMapMaps ComputeEnvMapMaps(const scene::Scene& scene, const scene::RayCaster& 
     maps.surface[t] = hits[t].surface;
     surface_texels.push_back(t);
   }
-  const HdrImage sky = SkyOnly(*env, is_sky, sun->dir);
+  const HdrImage sky = sky::SkyOnly(*env, is_sky, sun->dir);
   std::vector<float> env_distance(n, -1.0f);
   for (size_t t = 0; t < n; ++t) env_distance[t] = hits[t].IsHit() ? hits[t].t : -1.0f;
   std::vector<glm::vec3> points(surface_texels.size()), normals(surface_texels.size()), e(surface_texels.size()),
@@ -345,7 +345,7 @@ size_t CameraGBuffer::DiffuseCount() const {
 }
 
 
-SkyDistribution CapturedSky(const SceneBake& bake) {
+sky::SkyDistribution CapturedSky(const SceneBake& bake) {
   const EnvMapMaps& env = bake.env;
   HdrImage image{env.width, env.height, std::vector<float>(env.radiance.size() * 3)};
   std::vector<uint8_t> is_sky(env.surface.size());
@@ -353,7 +353,7 @@ SkyDistribution CapturedSky(const SceneBake& bake) {
     for (int c = 0; c < 3; ++c) image.rgb[t * 3 + static_cast<size_t>(c)] = env.radiance[t][c];
     is_sky[t] = env.IsSky(t) ? 1 : 0;
   }
-  return SkyDistribution(image, is_sky, bake.capture_sun.dir);
+  return sky::SkyDistribution(image, is_sky, bake.capture_sun.dir);
 }
 
 SceneBake RunBake(const scene::Scene& scene, const BakeOptions& options) {

@@ -90,8 +90,8 @@ std::string BakeHash(const scene::Scene& scene, const BakeOptions& options);
 SceneBake RunBake(const scene::Scene& scene, const BakeOptions& options);
 
 // The captured sky of `bake`'s env maps (their sky texels, the sun disc removed) as a (θ, γ)
-// table about the capture sun.
-SkyDistribution CapturedSky(const SceneBake& bake);
+// table about the capture sun (SkyDistribution::Under re-aims it at another).
+sky::SkyDistribution CapturedSky(const SceneBake& bake);
 
 // Writes the bake into `dir`: env_maps.exr, camera_gbuffer.exr, gather.exr (multi-layer OpenEXR),
 // albedo.csv, bake.json and PNG previews. Each file is written to a temporary name and renamed;

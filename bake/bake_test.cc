@@ -115,7 +115,7 @@ TEST(BakeTest, SkyFillFollowsZenithAngleAndSunAngle) {
       }
     }
   }
-  const HdrImage sky = SkyOnly(env, is_sky, glm::vec3(0, 0, 1));  // sun at the zenith: γ = θ
+  const HdrImage sky = sky::SkyOnly(env, is_sky, glm::vec3(0, 0, 1));  // sun at the zenith: γ = θ
   for (int v = 0; v < 90; v += 7) {
     const float expected = static_cast<float>(1.0 + 9.0 * (1.0 - LatLongDirection(270, v, 360, 180).z));
     EXPECT_NEAR(sky.Pixel(270, v)[0], expected, 0.2f) << v;  // within a 1° bin's spread

@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "scene/hdr_image.h"
+#include "sky/sky_distribution.h"
 
 namespace daylit::bake {
 
@@ -34,37 +35,6 @@ struct CaptureSun {
 // orientation). `given_dni` (sun_irradiance_rgb) wins over the map's own disc.
 CaptureSun ExtractSun(HdrImage* env, const glm::dvec3& sun_dir, const std::optional<glm::dvec3>& given_dni,
                       const std::string& name);
-
-// The captured sky as a function of the zenith angle θ and the angle γ from the sun (1° × 2°
-// bins, mean radiance of the sky texels in each). A clear sky is, to first order, a function of
-// (θ, γ) alone (the form of the Perez and CIE sky models), and the two carry what matters to a
-// wall: the bright sky near the horizon (up to ten times the zenith's) and the aureole around the
-// sun. So the table also gives the sky's distribution for another sun position: evaluate it with
-// that sun's γ. Bins the capture point never sees as sky (the low sky behind the buildings) are
-// filled harmonically (in log radiance) from the known bins around them.
-class SkyDistribution {
- public:
-  SkyDistribution() = default;
-  // From `env` (sun disc removed) where `is_sky[texel]`, with the sun at unit `sun_dir`.
-  SkyDistribution(const HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir);
-
-  bool empty() const { return mean_.empty(); }
-  // Radiance toward unit `dir` with the sun at unit `sun_dir` (bilinear between bins).
-  glm::vec3 Radiance(const glm::vec3& dir, const glm::vec3& sun_dir) const;
-  // Its diffuse horizontal irradiance ∫ L cos θ dω over the upper hemisphere with the sun at
-  // `sun_dir`, the number to divide by for a distribution per unit DHI.
-  glm::dvec3 HorizontalIrradiance(const glm::vec3& sun_dir) const;
-
- private:
-  static constexpr int kThetaBins = 181;  // 1° from the zenith to the nadir
-  static constexpr int kGammaBins = 90;   // 2° from the sun to its opposite
-  static size_t BinOf(const glm::vec3& dir, const glm::vec3& sun_dir);
-  std::vector<glm::vec3> mean_;  // [θ bin · kGammaBins + γ bin]
-};
-
-// The sky as seen from anywhere: `env` where the capture point sees sky (`is_sky[texel]`); where
-// it sees the model instead, the SkyDistribution of the visible sky at the same (θ, γ).
-HdrImage SkyOnly(const HdrImage& env, const std::vector<uint8_t>& is_sky, const glm::vec3& sun_dir);
 
 // Nearest-texel radiance of a lat-long map in direction `dir`, and of texel index `texel`.
 glm::vec3 Lookup(const HdrImage& env, const glm::vec3& dir);

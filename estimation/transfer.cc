@@ -301,7 +301,7 @@ uint32_t LightTransfer::OrientationOfKey(uint32_t key) {
 
 uint32_t LightTransfer::OrientationOf(const glm::vec3& normal) { return OrientationOfKey(OrientationKey(normal)); }
 
-std::vector<LightTransfer::OpenSky> LightTransfer::OpenSkyIntegrals(const glm::vec3& sun_dir,
+std::vector<LightTransfer::OpenSky> LightTransfer::OpenSkyIntegrals(const sky::SkyDistribution& table,
                                                                       const glm::vec3& inv_dhi) const {
   // Midpoint rule on a 1° × 2° grid of the upper hemisphere.
   constexpr int kRows = 90, kColumns = 180;
@@ -312,7 +312,7 @@ std::vector<LightTransfer::OpenSky> LightTransfer::OpenSkyIntegrals(const glm::v
     for (int c = 0; c < kColumns; ++c) {
       const float phi = 2.0f * glm::pi<float>() * (static_cast<float>(c) + 0.5f) / kColumns;
       dirs.emplace_back(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
-      radiance.push_back(sky_.Radiance(dirs.back(), sun_dir) * inv_dhi);
+      radiance.push_back(table.Radiance(dirs.back()) * inv_dhi);
       solid_angle.push_back(std::sin(theta) * (0.5f * glm::pi<float>() / kRows) * (2.0f * glm::pi<float>() / kColumns));
     }
   }
@@ -332,11 +332,12 @@ std::vector<glm::vec3> LightTransfer::ClearSkyPerUnitDhi(const glm::vec3& sun_di
                                                          const std::vector<glm::vec3>& dirs) const {
   std::vector<glm::vec3> out(dirs.size(), glm::vec3(glm::one_over_pi<float>()));
   if (sun_dir.z <= 0.0f || sky_.empty()) return out;
-  const glm::dvec3 dhi = sky_.HorizontalIrradiance(sun_dir);
+  const sky::SkyDistribution table = sky_.Under(sun_dir, options_.reaim_sky);
+  const glm::dvec3 dhi = table.HorizontalIrradiance();
   if (!(glm::compMin(dhi) > 0.0)) return out;
   const glm::vec3 inv_dhi(1.0 / dhi);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, dirs.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t i = range.begin(); i != range.end(); ++i) out[i] = sky_.Radiance(dirs[i], sun_dir) * inv_dhi;
+    for (size_t i = range.begin(); i != range.end(); ++i) out[i] = table.Radiance(dirs[i]) * inv_dhi;
   });
   return out;
 }
@@ -354,11 +355,12 @@ void LightTransfer::Compute(const std::vector<uint32_t>& pixels, const glm::vec3
 LightTransfer::ClearSky LightTransfer::ClearSkyUnder(const glm::vec3& sun_dir) const {
   ClearSky sky;
   if (sun_dir.z <= 0.0f || sky_.empty()) return sky;
-  const glm::dvec3 dhi = sky_.HorizontalIrradiance(sun_dir);
+  sky.table = sky_.Under(sun_dir, options_.reaim_sky);
+  const glm::dvec3 dhi = sky.table.HorizontalIrradiance();
   if (!(glm::compMin(dhi) > 0.0)) return sky;
   sky.on = true;
   sky.inv_dhi = glm::vec3(1.0 / dhi);
-  sky.open = OpenSkyIntegrals(sun_dir, sky.inv_dhi);
+  sky.open = OpenSkyIntegrals(sky.table, sky.inv_dhi);
   // π·L/DHI averaged over each cell's open rays: 1 for a uniform sky.
   sky.cell_weight.assign(cells_.size(), glm::vec3(1.0f));
   tbb::parallel_for(tbb::blocked_range<size_t>(0, cells_.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
@@ -366,7 +368,7 @@ LightTransfer::ClearSky LightTransfer::ClearSkyUnder(const glm::vec3& sun_dir) c
       const Cell& cell = cells_[c];
       if (cell.sky_begin == cell.sky_end) continue;
       glm::vec3 sum(0.0f);
-      for (uint32_t d = cell.sky_begin; d < cell.sky_end; ++d) sum += sky_.Radiance(UnpackDirection(cell_sky_[d]), sun_dir);
+      for (uint32_t d = cell.sky_begin; d < cell.sky_end; ++d) sum += sky.table.Radiance(UnpackDirection(cell_sky_[d]));
       sky.cell_weight[c] = sum * sky.inv_dhi * glm::pi<float>() / static_cast<float>(cell.sky_end - cell.sky_begin);
     }
   });
@@ -500,8 +502,8 @@ void LightTransfer::DirectAndReflected(const std::vector<uint32_t>& pixels, cons
       t.clear = glm::vec3(v);
       if (sky.on) {
         glm::vec3 blocked(0.0f), low(0.0f);
-        for (uint32_t d = paths.blocked_begin; d < paths.blocked_end; ++d) blocked += sky_.Radiance(block.blocked[d], sun_dir);
-        for (uint32_t d = paths.low_sky_begin; d < paths.low_sky_end; ++d) low += sky_.Radiance(block.low_sky[d], sun_dir);
+        for (uint32_t d = paths.blocked_begin; d < paths.blocked_end; ++d) blocked += sky.table.Radiance(block.blocked[d]);
+        for (uint32_t d = paths.low_sky_begin; d < paths.low_sky_end; ++d) low += sky.table.Radiance(block.low_sky[d]);
         t.clear = glm::max(sky.open[paths.orientation].clear + (low - blocked) * glm::pi<float>() * sky.inv_dhi * inv_rays,
                            glm::vec3(0.0f));
       }

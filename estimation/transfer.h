@@ -54,6 +54,8 @@ struct TransferOptions {
                                 // 3 left a tenth of the red light under an arcade out (transfer_test)
   bool close_series = true;     // the bounces past the last as a geometric series (SolveCells)
   bool sky_distribution = true; // the captured sky's (θ, γ) distribution; false: a uniform sky
+  bool reaim_sky = true;        // that sky re-aimed at each sun by a physical sky (docs/sky.md);
+                                // false: the captured table only read about the new sun
 
   // Empty when every field is in range, else the first problem, naming the field.
   std::string Check() const;
@@ -151,6 +153,7 @@ class LightTransfer {
   // without a captured sky.
   struct ClearSky {
     bool on = false;
+    sky::SkyDistribution table;  // the captured sky re-aimed at this sun
     glm::vec3 inv_dhi{0.0f};
     std::vector<OpenSky> open;  // per orientation
     std::vector<glm::vec3> cell_weight;  // per cell: π·L_clear/DHI over its open rays
@@ -183,14 +186,14 @@ class LightTransfer {
   static float CellEdge(uint32_t level);                     // m
   static uint64_t CellKey(const Bounce& b, uint32_t level);  // bake::SurfaceCellKey at that level's size
   // What an unoccluded surface of each orientation receives from the clear sky and a uniform one.
-  std::vector<OpenSky> OpenSkyIntegrals(const glm::vec3& sun_dir, const glm::vec3& inv_dhi) const;
+  std::vector<OpenSky> OpenSkyIntegrals(const sky::SkyDistribution& table, const glm::vec3& inv_dhi) const;
 
   const bake::SceneBake& bake_;
   TransferPoints points_;
   glm::vec3 capture_position_;
   const scene::RayCaster& caster_;
   TransferOptions options_;
-  bake::SkyDistribution sky_;       // empty: uniform sky
+  sky::SkyDistribution sky_;        // as captured; empty: uniform sky
   std::vector<glm::vec3> hemisphere_;
   std::vector<int32_t> slot_;       // per G-buffer pixel: index into paths_, −1 until traced
   std::vector<Paths> paths_;

@@ -11,6 +11,7 @@
 #include "base/log.h"
 #include "base/options_check.h"
 #include "base/statistics.h"
+#include "capture/frame_times.h"
 #include "estimation/sun_sky_fit.h"
 #include "report/plot.h"
 
@@ -45,6 +46,10 @@ ResidualSink::ResidualSink(const scene::Scene& scene, const bake::SceneBake& bak
 }
 
 void ResidualSink::Consume(const pipeline::PipelineFrame& frame) {
+  if (!last_utc_ || !(frame.frame.utc.SecondsSince(*last_utc_) < capture::kBurstGapS)) {
+    bursts_.emplace_back(strata_.size());
+  }
+  last_utc_ = frame.frame.utc;
   const estimation::FrameLight& light = frame.light;
   if (!light.fit.IsUsable() || light.samples.empty()) return;
   std::vector<glm::dvec3> observed(strata_.size(), glm::dvec3(0.0)), predicted(strata_.size(), glm::dvec3(0.0));
@@ -60,8 +65,10 @@ void ResidualSink::Consume(const pipeline::PipelineFrame& frame) {
   for (size_t key = 0; key < strata_.size(); ++key) {
     if (count[key] < static_cast<size_t>(options_.min_samples_per_frame)) continue;
     const glm::dvec3 p = glm::max(predicted[key], glm::dvec3(1e-12));
-    strata_[key].ratios.push_back(observed[key] / p);
-    strata_[key].samples += count[key];
+    for (Accumulated* a : {&strata_[key], &bursts_.back()[key]}) {
+      a->ratios.push_back(observed[key] / p);
+      a->samples += count[key];
+    }
   }
   if (light.fit.residual_spread <= worst_spread_ || frame.frame.rgb.empty()) return;
   // The new worst frame: its grey image, darkened, with each sample coloured by its ratio.
@@ -80,8 +87,9 @@ void ResidualSink::Consume(const pipeline::PipelineFrame& frame) {
   }
 }
 
-std::optional<StratumResidual> ResidualSink::StratumOf(size_t surface, bool sunlit) const {
-  const Accumulated& a = strata_[2 * surface + (sunlit ? 1 : 0)];
+std::optional<StratumResidual> ResidualSink::StratumOf(const std::vector<Accumulated>& strata, size_t surface,
+                                                      bool sunlit) const {
+  const Accumulated& a = strata[2 * surface + (sunlit ? 1 : 0)];
   if (a.ratios.empty()) return std::nullopt;
   StratumResidual r;
   r.surface = scene_.model.surface_names[surface];
@@ -101,7 +109,22 @@ std::vector<StratumResidual> ResidualSink::Strata() const {
   std::vector<StratumResidual> out;
   for (size_t surface = 0; 2 * surface < strata_.size(); ++surface) {
     for (const bool sunlit : {true, false}) {
-      if (const std::optional<StratumResidual> r = StratumOf(surface, sunlit)) out.push_back(*r);
+      if (const std::optional<StratumResidual> r = StratumOf(strata_, surface, sunlit)) out.push_back(*r);
+    }
+  }
+  return out;
+}
+
+std::vector<StratumResidual> ResidualSink::BurstStrata() const {
+  std::vector<StratumResidual> out;
+  for (size_t b = 0; b < bursts_.size(); ++b) {
+    for (size_t surface = 0; 2 * surface < strata_.size(); ++surface) {
+      for (const bool sunlit : {true, false}) {
+        if (std::optional<StratumResidual> r = StratumOf(bursts_[b], surface, sunlit)) {
+          r->burst = static_cast<int>(b);
+          out.push_back(*r);
+        }
+      }
     }
   }
   return out;
@@ -110,7 +133,8 @@ std::vector<StratumResidual> ResidualSink::Strata() const {
 std::vector<ResidualFinding> ResidualSink::Findings() const {
   std::vector<ResidualFinding> findings;
   for (size_t surface = 0; 2 * surface < strata_.size(); ++surface) {
-    const std::optional<StratumResidual> sunlit_stratum = StratumOf(surface, true), shadowed_stratum = StratumOf(surface, false);
+    const std::optional<StratumResidual> sunlit_stratum = StratumOf(strata_, surface, true),
+                                         shadowed_stratum = StratumOf(strata_, surface, false);
     const StratumResidual* sunlit = sunlit_stratum ? &*sunlit_stratum : nullptr;
     const StratumResidual* shadowed = shadowed_stratum ? &*shadowed_stratum : nullptr;
     const bool sun_off = sunlit != nullptr && sunlit->biased, shade_off = shadowed != nullptr && shadowed->biased;
@@ -147,18 +171,21 @@ std::vector<ResidualFinding> ResidualSink::Findings() const {
 }
 
 std::string ResidualsCsv(const std::vector<StratumResidual>& strata) {
-  std::string csv = "surface,stratum,frames,samples,ratio_r,ratio_g,ratio_b,biased\n";
+  std::string csv = "burst,surface,stratum,frames,samples,ratio_r,ratio_g,ratio_b,biased\n";
   for (const StratumResidual& r : strata) {
-    csv += fmt::format("{},{},{},{},{:.4f},{:.4f},{:.4f},{}\n", r.surface, r.sunlit ? "sunlit" : "shadowed", r.frames,
-                       r.samples, r.ratio.x, r.ratio.y, r.ratio.z, r.biased ? 1 : 0);
+    csv += fmt::format("{},{},{},{},{},{:.4f},{:.4f},{:.4f},{}\n", r.burst < 0 ? "all" : std::to_string(r.burst), r.surface,
+                       r.sunlit ? "sunlit" : "shadowed", r.frames, r.samples, r.ratio.x, r.ratio.y, r.ratio.z,
+                       r.biased ? 1 : 0);
   }
   return csv;
 }
 
 void ResidualSink::Finish(const std::filesystem::path& dir, RunReport* report) const {
   std::filesystem::create_directories(dir);
-  const std::vector<StratumResidual> strata = Strata();
-  WriteFileAtomically(dir / "residuals.csv", ResidualsCsv(strata));
+  const std::vector<StratumResidual> strata = Strata(), per_burst = BurstStrata();
+  std::vector<StratumResidual> all = strata;
+  all.insert(all.end(), per_burst.begin(), per_burst.end());
+  WriteFileAtomically(dir / "residuals.csv", ResidualsCsv(all));
   report::BarChartOptions chart;
   chart.title = fmt::format("{}: observed / predicted radiance per surface and stratum (median over frames)", scene_.name);
   chart.x_label = "observed / predicted (R, G, B)";
@@ -169,7 +196,14 @@ void ResidualSink::Finish(const std::filesystem::path& dir, RunReport* report) c
     rows.push_back({fmt::format("{} {}{}", r.surface, r.sunlit ? "sunlit" : "shadow", r.biased ? " *" : ""),
                     {r.ratio.x, r.ratio.y, r.ratio.z}});
   }
-  report::WritePng(dir / "residuals.png", {report::RenderBarChart(chart, rows)});
+  report::BarChartOptions burst_chart = chart;
+  burst_chart.title = fmt::format("{}: the same per burst (median over each burst's frames)", scene_.name);
+  std::vector<report::BarRow> burst_rows;
+  for (const StratumResidual& r : per_burst) {
+    burst_rows.push_back({fmt::format("burst {} {} {}{}", r.burst, r.surface, r.sunlit ? "sunlit" : "shadow", r.biased ? " *" : ""),
+                          {r.ratio.x, r.ratio.y, r.ratio.z}});
+  }
+  report::WritePng(dir / "residuals.png", {report::RenderBarChart(chart, rows), report::RenderBarChart(burst_chart, burst_rows)});
   if (!worst_image_.empty()) report::WritePng(dir / "worst_frame_residuals.png", {worst_image_});
   const std::vector<ResidualFinding> findings = Findings();
   report->Say(fmt::format("residuals (observed/predicted per surface and stratum, no truth needed): {} of {} strata "

@@ -17,6 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "bake/bake.h"
+#include "base/utc_time.h"
 #include "evaluation/run_report.h"
 #include "pipeline/lighting_pipeline.h"
 #include "scene/scene.h"
@@ -32,8 +33,9 @@ struct ResidualOptions {
   std::string Check() const;
 };
 
-// One surface's stratum over the run.
+// One surface's stratum over the run, or over one burst of it.
 struct StratumResidual {
+  int burst = -1;        // −1: the whole run
   std::string surface;
   bool sunlit = false;
   int frames = 0;        // frames with enough samples of it
@@ -57,6 +59,9 @@ class ResidualSink final : public pipeline::FrameSink {
 
   // Every surface's strata that had samples, surfaces in the model's order, sunlit first.
   std::vector<StratumResidual> Strata() const;
+  // The same per burst (frames less than 2 s apart), bursts in order: a burst's bias averages
+  // away over a run of several.
+  std::vector<StratumResidual> BurstStrata() const;
   std::vector<ResidualFinding> Findings() const;
   // residuals.csv, residuals.png (the ratios as bars) and worst_frame_residuals.png (the frame
   // with the largest residual spread, each sample coloured by its ratio) into `dir`; each finding
@@ -68,12 +73,15 @@ class ResidualSink final : public pipeline::FrameSink {
     std::vector<glm::dvec3> ratios;  // per frame
     size_t samples = 0;
   };
-  // A surface's stratum over the run; nullopt when no frame had enough samples of it.
-  std::optional<StratumResidual> StratumOf(size_t surface, bool sunlit) const;
+  // A surface's stratum over `strata` (the run's or a burst's); nullopt when no frame had enough
+  // samples of it.
+  std::optional<StratumResidual> StratumOf(const std::vector<Accumulated>& strata, size_t surface, bool sunlit) const;
   const scene::Scene& scene_;
   const bake::SceneBake& bake_;
   ResidualOptions options_;
   std::vector<Accumulated> strata_;  // [surface · 2 + sunlit]
+  std::vector<std::vector<Accumulated>> bursts_;  // the same per burst
+  std::optional<UtcTime> last_utc_;
   // The worst frame so far: its residual spread, its number, and its image (8-bit, the samples
   // drawn on it).
   double worst_spread_ = -1.0;
@@ -81,7 +89,8 @@ class ResidualSink final : public pipeline::FrameSink {
   cv::Mat worst_image_;
 };
 
-// residuals.csv: surface,stratum,frames,samples,ratio_r,ratio_g,ratio_b,biased.
+// residuals.csv: burst,surface,stratum,frames,samples,ratio_r,ratio_g,ratio_b,biased (burst "all":
+// the whole run).
 std::string ResidualsCsv(const std::vector<StratumResidual>& strata);
 
 }  // namespace daylit::evaluation

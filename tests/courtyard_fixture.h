@@ -38,6 +38,19 @@ inline const BundledCourtyard& CourtyardC() {
   return courtyard;
 }
 
+// courtyard-b: Florence in September, a portico whose back wall is lit by reflected light (issue 37).
+inline const BundledCourtyard& CourtyardB() {
+  static const BundledCourtyard courtyard = LoadBundled("courtyard-b");
+  return courtyard;
+}
+
+// courtyard-e: as real scenes are (issue 38): a sketched model, windows, clutter, glossy materials,
+// two bursts under a photographed sky.
+inline const BundledCourtyard& CourtyardE() {
+  static const BundledCourtyard courtyard = LoadBundled("courtyard-e");
+  return courtyard;
+}
+
 // A measured figure under `key` ("courtyard-a/volume/p95_error"), in gtest's output for
 // scripts/results.sh to put on docs/results.md: fractions for errors, seconds for times.
 inline void RecordFigure(const std::string& key, double value) {

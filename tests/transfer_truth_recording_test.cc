@@ -49,21 +49,20 @@ float Median(std::vector<float> v) {
 // The path tracer's irradiance at (x, n) with the sky table scaled by `sky_scale`, less the
 // direct sun at x.
 glm::vec3 BruteIrradiance(const scene::RayCaster& caster, const glm::vec3& x, const glm::vec3& n,
-                          const std::vector<glm::vec3>& albedo, const bake::SkyDistribution& sky, const glm::vec3& sky_scale,
+                          const std::vector<glm::vec3>& albedo, const sky::SkyDistribution& sky, const glm::vec3& sky_scale,
                           const glm::vec3& sun, const glm::vec3& e_sun, int paths, int depth, std::mt19937& rng) {
   const estimation::testing::ReferenceLight light{
-      sun, e_sun, [&](const glm::vec3& d) { return sky.Radiance(d, sun) * sky_scale; }, albedo};
+      sun, e_sun, [&](const glm::vec3& d) { return sky.Radiance(d) * sky_scale; }, albedo};
   return estimation::testing::PathTracedIndirectAndSky(caster, light, x, n, paths, depth, rng);
 }
 
-TEST(TransferTruthRecordingTest, BakeCaptureIrradianceMatchesAPathTracerOnCourtyardC) {
-  const testing::BundledCourtyard& c = testing::CourtyardC();
+void CaptureIrradianceAgainstAPathTracer(const testing::BundledCourtyard& c, const std::string& recording) {
   const scene::RayCaster caster(c.scene.model);
   const bake::EnvMapMaps& e = c.bake.env;
-  const bake::SkyDistribution sky = bake::CapturedSky(c.bake);
+  const sky::SkyDistribution sky = bake::CapturedSky(c.bake);
   std::vector<glm::vec3> rho(c.scene.model.surface_names.size(), glm::vec3(0.3f));
   for (size_t s = 0; s < c.bake.albedo_table.size(); ++s) rho[s] = c.bake.albedo_table[s].albedo;
-  const std::string dir = DAYLIT_SOURCE_DIR "/recordings/courtyard-c/";
+  const std::string dir = DAYLIT_SOURCE_DIR "/recordings/" + recording + "/";
   std::ifstream in(dir + "groundtruth/albedo.json");
   const nlohmann::json j = nlohmann::json::parse(in);
   for (auto& [name, v] : j.items()) {
@@ -103,6 +102,10 @@ TEST(TransferTruthRecordingTest, BakeCaptureIrradianceMatchesAPathTracerOnCourty
   }
 }
 
+TEST(TransferTruthRecordingTest, BakeCaptureIrradianceMatchesAPathTracerOnCourtyardC) {
+  CaptureIrradianceAgainstAPathTracer(testing::CourtyardC(), "courtyard-c");
+}
+
 // A stratum held to its own bar: frame, surface, sunlit, and the bar on truth / daylit.
 struct WiderBar {
   int frame;
@@ -129,7 +132,7 @@ void ClearFrames(const testing::BundledCourtyard& c, const std::string& recordin
       if (s >= 0) true_albedo[static_cast<size_t>(s)] = glm::vec3(v[0].get<float>(), v[1].get<float>(), v[2].get<float>());
     }
   }
-  const bake::SkyDistribution sky = bake::CapturedSky(c.bake);
+  const sky::SkyDistribution captured_sky = bake::CapturedSky(c.bake);
   for (const int frame : frames) {
     const HdrImage L = scene::ReadHdrImage(fmt::format("{}groundtruth/without_objects/{:06d}.exr", dir, frame));
     scene::SunTracker tracker(c.scene);
@@ -148,7 +151,8 @@ void ClearFrames(const testing::BundledCourtyard& c, const std::string& recordin
     const auto row = truth.rows[static_cast<size_t>(frame)];
     const glm::vec3 e_sun(std::stof(row[1]), std::stof(row[2]), std::stof(row[3]));
     const glm::vec3 e_sky(std::stof(row[4]), std::stof(row[5]), std::stof(row[6]));
-    const glm::vec3 sky_scale = e_sky / glm::vec3(sky.HorizontalIrradiance(sun.dir_in_scene));
+    const sky::SkyDistribution sky = captured_sky.Under(sun.dir_in_scene);
+    const glm::vec3 sky_scale = e_sky / glm::vec3(sky.HorizontalIrradiance());
     std::vector<glm::vec3> brute(pixels.size()), brute_true(pixels.size());
     tbb::parallel_for(size_t{0}, pixels.size(), [&](size_t k) {
       std::mt19937 rng(static_cast<uint32_t>(k * 7919 + 1));

@@ -12,6 +12,7 @@
 #include "base/log.h"
 #include "evaluation/lighting_truth.h"
 #include "evaluation/residuals.h"
+#include "evaluation/split_check.h"
 #include "evaluation/run_report.h"
 #include "pipeline/lighting_pipeline.h"
 #include "scene/raycaster.h"
@@ -28,12 +29,14 @@ struct EstimateCommandOptions {
   std::string figures;
   std::string residuals;
   evaluation::ResidualOptions residual;
+  evaluation::SplitCheckOptions split;
   pipeline::LightingPipelineOptions pipeline;
 };
 
 void RunEstimateCommand(const EstimateCommandOptions& o) {
   if (const std::string why = o.pipeline.Check(); !why.empty()) ThrowInputError("options: {}", why);
   if (const std::string why = o.residual.Check(); !why.empty()) ThrowInputError("--residual-{}", why);
+  if (!(o.split.threshold > 0.0 && o.split.threshold <= 10.0)) ThrowInputError("--split-threshold: {} is not in (0, 10]", o.split.threshold);
   if (!o.figures.empty() && std::filesystem::path(o.figures).extension() != ".json") {
     ThrowInputError("--figures: {} must end in .json", o.figures);
   }
@@ -55,7 +58,14 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   const scene::RayCaster caster(scene.model);
   pipeline::LightingPipeline lighting(scene, baked, caster, options);
   std::optional<evaluation::ResidualSink> residuals;
-  if (!o.residuals.empty()) lighting.AddSink(&residuals.emplace(scene, baked, o.residual));
+  std::optional<evaluation::SplitCheck> split;
+  std::optional<evaluation::SplitCheckSink> split_sink;
+  if (!o.residuals.empty()) {
+    lighting.AddSink(&residuals.emplace(scene, baked, o.residual));
+    evaluation::SplitCheckOptions split_options = o.split;
+    split_options.fit = options.estimator.fit;  // the refits are the estimator's fits
+    lighting.AddSink(&split_sink.emplace(&split.emplace(scene, baked, split_options)));
+  }
   // A recording's shadows are checked against the model's (north and clock); a live run is not.
   std::optional<ShadowCheckSink> shadows;
   if (scene.frame_times) lighting.AddSink(&shadows.emplace(scene, baked));
@@ -67,6 +77,7 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   evaluation::RunFigures(run, &report);
   evaluation::ReportLighting(scene, run.frames, o.out, plot, &report);
   if (residuals) residuals->Finish(o.residuals, &report);
+  if (split) split->Finish(o.residuals, &report);
   if (shadows) CheckShadowsAndSay(scene, baked, caster, shadows->Finish(), &report);
   if (!o.figures.empty()) report.WriteFigures(o.figures);
   Log().info("{} frames in {:.2f} s ({:.0f} fps end to end); estimation after decoding {:.2f} ms per frame (median), "
@@ -89,11 +100,16 @@ void AddEstimateCommand(CLI::App& app) {
   cmd->add_option("--out", options->out, "Estimates CSV (default estimates.csv)");
   cmd->add_option("--plot", options->plot, "Plot PNG (default: the CSV's name with .png)");
   cmd->add_option("--residuals", options->residuals,
-                  "A folder for the self-check that needs no truth: per surface and sunlit/shadowed stratum, observed/"
-                  "predicted radiance (residuals.csv, residuals.png, worst_frame_residuals.png); biased surfaces are "
-                  "named on stderr with their likely cause");
+                  "A folder for the self-check that needs no truth: per surface and sunlit/shadowed stratum, over the "
+                  "run and per burst, observed/predicted radiance (residuals.csv, residuals.png, "
+                  "worst_frame_residuals.png; biased surfaces are named on stderr with their likely cause), and the fit "
+                  "repeated with each stratum left out (split_check.csv, split_check.png; bursts whose estimate one "
+                  "stratum moves beyond --split-threshold are named on stderr)");
   cmd->add_option("--residual-threshold", options->residual.threshold,
                   "A surface is biased when its ratio is further than this from 1 in a channel (default 0.12)");
+  cmd->add_option("--split-threshold", options->split.threshold,
+                  "A burst's split is flagged when one stratum left out moves E_sun or E_sky by more than this "
+                  "(jackknife standard error, relative; default 0.05)");
   cmd->add_option("--figures", options->figures,
                   "Also write the run's figures as JSON (fps, ms per frame, errors against the truth; docs/results.md)");
   cmd->add_option("--samples", options->pipeline.estimator.sampler.samples, "Samples per frame (default 8000)")
