@@ -2,7 +2,11 @@
 
 #include "base/options_check.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <fmt/format.h>
+#include <glm/gtx/component_wise.hpp>
 
 #include "base/check.h"
 #include "base/error.h"
@@ -14,6 +18,9 @@ glm::vec3 CapturePoint(const scene::Scene& scene) {
   return scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f);
 }
 
+// 1/sin elevation, the sun taken at 1° or higher.
+double AirMass(const glm::vec3& sun_dir) { return 1.0 / std::max(static_cast<double>(sun_dir.z), 0.0175); }
+
 }  // namespace
 
 FrameEstimator::FrameEstimator(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
@@ -24,6 +31,32 @@ FrameEstimator::FrameEstimator(const scene::Scene& scene, const bake::SceneBake&
       filter_(options.filter),
       linearizer_(scene.response) {
   DAYLIT_CHECK(options.Check().empty(), "{}", options.Check());
+  // The capture's sun above the atmosphere: its DNI over the transmittance at its elevation.
+  const sky::SkyDistribution& sky = sampler_.transfer().CapturedSky();
+  const glm::dvec3 dni(bake.capture_sun.dni_rgb);
+  if (bake.capture_sun.above_horizon && glm::compMin(dni) > 0.0 && !sky.empty()) {
+    const glm::dvec3 above = dni / glm::max(sky.SunUnder(sky.sun(), glm::dvec3(1.0)), glm::dvec3(1e-9));
+    sun_colour_ = SunColourMemory(options.sun_colour, above, AirMass(sky.sun()));
+  } else {
+    sun_colour_ = SunColourMemory(options.sun_colour);
+  }
+}
+
+SunSkyFitSummary FrameEstimator::FitWithSunColour(const std::vector<Sample>& samples, const glm::vec3& sun_dir,
+                                                  const UtcTime& utc) {
+  const sky::SkyDistribution& sky = sampler_.transfer().CapturedSky();
+  if (!options_.sun_colour.on || sky.empty() || sun_dir.z <= 0.0f) return FitSunSky(options_.fit, samples);
+  const SunColourMemory::Colour carried = sun_colour_.At(utc, AirMass(sun_dir));
+  // The colour here: above the atmosphere times its transmittance toward this sun (relative to the
+  // capture's, which cancels in a colour). A weak sun takes it (MixWithCarriedColour).
+  const glm::dvec3 transmittance = sky.SunUnder(sun_dir, glm::dvec3(1.0));
+  SunSkyFitSummary fit = FitSunSkyAsCarried(options_.fit, samples, carried.above * transmittance, carried.weight);
+  if (!fit.IsUsable() || fit.sunlit_samples == 0) return fit;
+  // The frame's own sun (unmixed) measures the colour, as well as its weight says.
+  if (glm::compMin(fit.own.sun_rgb) > 0.0) {
+    sun_colour_.Measure(utc, fit.own.sun_rgb / glm::max(transmittance, glm::dvec3(1e-9)), SunColourWeight(fit));
+  }
+  return fit;
 }
 
 FrameEstimate FrameEstimator::Row(const capture::Frame& frame, const scene::TrackedSun& sun) const {
@@ -49,7 +82,7 @@ FrameLight FrameEstimator::Estimate(const capture::Frame& frame, const scene::Tr
   const double t_s = SecondsSinceFirst(frame.utc);
   out.sun_moved = sampler_.SetSun(sun.dir_in_scene);
   out.samples = sampler_.Draw(frame.rgb, frame.exposure, frame.linear ? nullptr : &linearizer_);
-  out.fit = FitSunSky(options_.fit, out.samples);
+  out.fit = FitWithSunColour(out.samples, sun.dir_in_scene, frame.utc);
   const FilteredLight filtered =
       filter_.Update(t_s, out.fit.IsUsable() ? std::optional<SunSky>(out.fit.light) : std::nullopt, out.fit.confidence);
   if (out.fit.IsUsable()) overcast_share_ = out.fit.overcast_share;
@@ -125,7 +158,8 @@ std::string EstimatesCsv(const std::vector<FrameEstimate>& frames) {
 }
 
 std::string FrameEstimatorOptions::Check() const {
-  return FirstProblem({Nested("sampler", sampler.Check()), Nested("fit", fit.Check()), Nested("filter", filter.Check())});
+  return FirstProblem({Nested("sampler", sampler.Check()), Nested("fit", fit.Check()), Nested("filter", filter.Check()),
+                       Nested("sun_colour", sun_colour.Check())});
 }
 
 }  // namespace daylit::estimation

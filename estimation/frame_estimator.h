@@ -10,6 +10,7 @@
 #include "bake/bake.h"
 #include "capture/frame_source.h"
 #include "estimation/sampler.h"
+#include "estimation/sun_colour.h"
 #include "estimation/sun_sky_fit.h"
 #include "estimation/temporal_filter.h"
 #include "scene/raycaster.h"
@@ -22,6 +23,7 @@ struct FrameEstimatorOptions {
   SamplerOptions sampler;
   SunSkyFitOptions fit;
   TemporalFilterOptions filter;
+  SunColourOptions sun_colour;
   // Empty when every field is in range, else the first problem, naming the field.
   std::string Check() const;
 };
@@ -70,6 +72,10 @@ class FrameEstimator {
  private:
   FrameEstimate Row(const capture::Frame& frame, const scene::TrackedSun& sun) const;
   double SecondsSinceFirst(const UtcTime& utc);
+  // The fit of `samples` with the sun's colour carried over where the frame's own sun is weak
+  // (its share of the sunlit samples' light below the fit's confident share), and the colour
+  // updated from it.
+  SunSkyFitSummary FitWithSunColour(const std::vector<Sample>& samples, const glm::vec3& sun_dir, const UtcTime& utc);
 
   const bake::SceneBake& bake_;
   FrameEstimatorOptions options_;
@@ -78,6 +84,7 @@ class FrameEstimator {
   capture::Linearizer linearizer_;
   std::optional<UtcTime> first_utc_;
   double overcast_share_ = 0.0;
+  SunColourMemory sun_colour_;
 };
 
 // The unfiltered fit of one frame (its position in frames.csv), as the estimator makes it:

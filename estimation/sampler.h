@@ -58,6 +58,7 @@ class Sampler {
   std::vector<Sample> Draw(const cv::Mat& frame, double exposure, const capture::Linearizer* linearizer = nullptr) const;
 
   size_t StratumCount() const { return strata_.size(); }
+  const LightTransfer& transfer() const { return transfer_; }
   // The current sun visibility of each pixel (1: sunlit), and its boundary exclusion mask.
   const std::vector<uint8_t>& sunlit() const { return sunlit_; }
   const std::vector<uint8_t>& near_boundary() const { return near_boundary_; }

@@ -145,6 +145,8 @@ class ChannelFitter {
   // After Fit: the samples' residuals relative to the prediction, in the order of `rows`.
   const std::vector<double>& relative() const { return relative_; }
   bool converged() const { return converged_; }
+  // The normal equations at the last fit's final weights (for the channel it was loaded with).
+  NormalEquations FinalEquations() { return Equations(); }
 
   // Channel `c` over the samples `rows`: with `split`, E_sun, E_clear and E_overcast; without,
   // E_sun and E_clear with E_overcast given as `overcast` (the grey part, the same in every
@@ -345,7 +347,8 @@ glm::vec3 PredictedRadiance(const Sample& s, const SunSky& light, double overcas
   return PredictedRadiance(s, SplitLight(light, overcast_share));
 }
 
-SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sample>& samples) {
+SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sample>& samples,
+                           const glm::dvec3* sun_colour) {
   SunSkyFitSummary summary;
   std::vector<size_t> usable;
   for (size_t i = 0; i < samples.size(); ++i) {
@@ -375,6 +378,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   int unconverged_channels = 0;  // final fits that ran out of IRLS iterations
   std::vector<double> spreads, all_residuals, scratch;
   all_residuals.reserve(3 * n);
+  std::array<NormalEquations, 3> final_equations{};
   for (int c = 0; c < 3; ++c) {
     const ChannelFit& split = split_fits[static_cast<size_t>(c)];
     const ChannelFit start{split[0], split[1], 0.0};
@@ -382,12 +386,41 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
     unconverged_channels += fitter.converged() ? 0 : 1;
     summary.light.sun_rgb[c] = fit[0];
     summary.light.sky_rgb[c] = fit[1] + overcast;
+    if (sun_colour != nullptr) final_equations[static_cast<size_t>(c)] = fitter.FinalEquations();
     scratch.clear();
     for (size_t k = 0; k < n; ++k) {
       all_residuals.push_back(std::abs(fitter.relative()[k]));
       if (fitter.InMedians(usable[k])) scratch.push_back(std::abs(fitter.relative()[k]));
     }
     spreads.push_back(1.4826 * MedianInPlace(scratch, 0.0));
+  }
+  if (sun_colour != nullptr && with_sun && glm::compMin(*sun_colour) > 0.0) {
+    // The sun's colour given (clouds are grey: a cloud dims the beam, it does not colour it): one
+    // magnitude s for E_sun = s·colour over the three channels, each channel's clear sky profiled
+    // out at the final weights. Each channel's information on its E_sun is the Schur complement
+    // A_ss − A_sc²/A_cc of its normal equations, so s weighs the channels by what they know of the
+    // sun, and the clear sky follows.
+    double num = 0.0, den = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      const NormalEquations& eq = final_equations[static_cast<size_t>(c)];
+      const double colour = (*sun_colour)[c];
+      if (!(eq.a[1][1] > 0.0)) continue;
+      num += colour * (eq.b[0] - eq.a[0][1] * eq.b[1] / eq.a[1][1]);
+      den += colour * colour * (eq.a[0][0] - eq.a[0][1] * eq.a[0][1] / eq.a[1][1]);
+    }
+    if (den > 0.0) {
+      const double magnitude = std::max(0.0, num / den);
+      SunSky coloured;
+      for (int c = 0; c < 3; ++c) {
+        const NormalEquations& eq = final_equations[static_cast<size_t>(c)];
+        const double sun = magnitude * (*sun_colour)[c];
+        const double clear = eq.a[1][1] > 0.0 ? std::max(0.0, (eq.b[1] - eq.a[0][1] * sun) / eq.a[1][1])
+                                              : summary.light.sky_rgb[c] - overcast;
+        coloured.sun_rgb[c] = sun;
+        coloured.sky_rgb[c] = clear + overcast;
+      }
+      summary.coloured = coloured;
+    }
   }
   summary.residual_spread = *std::max_element(spreads.begin(), spreads.end());
   // The share that gives that grey part back (SplitLight).
@@ -401,6 +434,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   summary.status = unconverged_channels > 0 ? SunSkyFitStatus::kNoConvergence
                    : with_sun                ? SunSkyFitStatus::kConverged
                                              : SunSkyFitStatus::kSkyOnly;
+  summary.own = summary.light;
   summary.message = fmt::format("{} samples ({} sunlit, {} shadowed{}), residual spread {:.3f}{}", n,
                                 summary.sunlit_samples, summary.shadowed_samples,
                                 summary.sun_up && !with_sun ? ": the sun is up but reaches none, E_sun not observed" : "",
@@ -410,6 +444,32 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
                                                   unconverged_channels, options.iterations)
                                     : std::string());
   return summary;
+}
+
+double SunColourWeight(const SunSkyFitSummary& fit) {
+  const double share = std::clamp(fit.sun_share_sunlit, 0.0, 1.0);
+  const double odds = share / std::max(1.0 - share, 1e-3);
+  return odds * odds;
+}
+
+SunSky MixWithCarriedColour(const SunSkyFitOptions& options, const SunSkyFitSummary& fit, double carried_weight) {
+  if (!fit.coloured || !(carried_weight > 0.0) || fit.sun_share_sunlit >= options.confident_share) return fit.light;
+  const double own = SunColourWeight(fit);
+  const double t = own / (own + carried_weight);
+  SunSky mixed;
+  mixed.sun_rgb = t * fit.light.sun_rgb + (1.0 - t) * fit.coloured->sun_rgb;
+  mixed.sky_rgb = t * fit.light.sky_rgb + (1.0 - t) * fit.coloured->sky_rgb;
+  return mixed;
+}
+
+SunSkyFitSummary FitSunSkyAsCarried(const SunSkyFitOptions& options, const std::vector<Sample>& samples,
+                                    const glm::dvec3& carried_colour, double carried_weight) {
+  SunSkyFitSummary fit = carried_weight > 0.0 ? FitSunSky(options, samples, &carried_colour) : FitSunSky(options, samples);
+  fit.carried_colour = carried_colour;
+  fit.carried_weight = carried_weight;
+  fit.own = fit.light;
+  if (fit.IsUsable() && fit.sunlit_samples > 0) fit.light = MixWithCarriedColour(options, fit, carried_weight);
+  return fit;
 }
 
 }  // namespace daylit::estimation

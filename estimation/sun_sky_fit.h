@@ -13,6 +13,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -87,13 +88,42 @@ struct SunSkyFitSummary {
   // reflected from nearby walls.
   double sun_share_sunlit = 1.0;
   double sky_share_shadowed = 1.0;
+  // With a sun colour given (FitSunSky), the light with E_sun of that colour: one magnitude from
+  // the three channels, each weighed by what it knows of the sun (its normal equations' Schur
+  // complement, the clear sky profiled out), and each channel's clear sky refitted with it. The
+  // grey overcast part is the same. Clouds are grey: a cloud dims the beam, it does not colour
+  // it, so a weak sun's colour is the clear one's, and the channel whose sun is the smallest part
+  // of the light (blue under a low sun) no longer trades its sun for sky on its own.
+  std::optional<SunSky> coloured;
+  // What the estimator carried into this frame (FrameEstimator): the sun's colour here and its
+  // weight (estimation/sun_colour.h); weight 0: none.
+  glm::dvec3 carried_colour{1.0};
+  double carried_weight = 0.0;
+  // The frame's own light before the carried colour was mixed in (FitSunSkyAsCarried); `light`
+  // itself when nothing was mixed.
+  SunSky own;
   std::string message;
 
   bool IsUsable() const { return status != SunSkyFitStatus::kTooFewSamples; }
 };
 
 // Fits E_sun and E_sky to `samples`. Never throws; a frame that cannot be fitted returns a
-// summary with status kTooFewSamples and a message.
-SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sample>& samples);
+// summary with status kTooFewSamples and a message. With `sun_colour` (RGB, > 0), the summary
+// also has the fit with E_sun that colour times one magnitude over the three channels (`coloured`).
+SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sample>& samples,
+                           const glm::dvec3* sun_colour = nullptr);
+
+// A frame's own measure of its sun's colour: a model error in the sky part passes to E_sun
+// amplified by (1 − share)/share (share: the sun's part of the sunlit samples' light, worst
+// channel), so a frame weighs the inverse square of that (1 at a share of one half).
+double SunColourWeight(const SunSkyFitSummary& fit);
+// The light of `fit` (made with a sun colour of weight `carried_weight`): a weak sun (below the
+// options' confident share) mixes its own fit with the coloured one by the two weights; a clear
+// frame keeps its own.
+SunSky MixWithCarriedColour(const SunSkyFitOptions& options, const SunSkyFitSummary& fit, double carried_weight);
+// FitSunSky with the colour a frame carried (its carried_colour and carried_weight), mixed as the
+// estimator mixes it: what refits of a frame's samples (the split check) do.
+SunSkyFitSummary FitSunSkyAsCarried(const SunSkyFitOptions& options, const std::vector<Sample>& samples,
+                                    const glm::dvec3& carried_colour, double carried_weight);
 
 }  // namespace daylit::estimation

@@ -104,6 +104,8 @@ class LightTransfer {
   // 1/π (a uniform sky) without a captured sky or with the sun down.
   std::vector<glm::vec3> ClearSkyPerUnitDhi(const glm::vec3& sun_dir, const std::vector<glm::vec3>& dirs) const;
 
+  // The captured sky (about the capture's sun; empty without one).
+  const sky::SkyDistribution& CapturedSky() const { return sky_; }
   size_t TracedPixels() const { return paths_.size(); }
   size_t Cells() const { return cells_.size(); }
   // Whether T_clear differs from T_overcast: a captured sky with the sun up.

@@ -101,7 +101,7 @@ SplitCheck::Checked SplitCheck::CheckFrame(const std::vector<estimation::Sample>
     // Without any sunlit sample E_sun is not observed and E_sky would take the reflected sun for
     // sky: that refit says nothing about the split.
     if (fit.sunlit_samples > 0 && !sunlit_left) return;
-    refits[k] = estimation::FitSunSky(options_.fit, others);
+    refits[k] = estimation::FitSunSkyAsCarried(options_.fit, others, fit.carried_colour, fit.carried_weight);
     usable[k] = refits[k].IsUsable() ? 1 : 0;
   });
   std::vector<glm::dvec3> sun_moves, sky_moves;

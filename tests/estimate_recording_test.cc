@@ -73,6 +73,8 @@ void ExpectPerBurst(const testing::BundledCourtyard& c, double p90_bar, double a
     }
   }
   testing::RecordFigure(c.scene.name + "/estimate/p90_worst_channel", truth.p90_worst_channel_error);
+  // Issue 37: no more than 5% of the frames more than 10% off.
+  EXPECT_LE(truth.ranking.bad_frames, truth.frames / 20) << c.scene.name;
   EXPECT_LE(truth.p90_worst_channel_error, p90_bar) << c.scene.name;
   // The confidence ranks frames by their true error (frames over 10% against those within 5%);
   // with no frame over 10% there is nothing to rank.
@@ -91,14 +93,12 @@ TEST(EstimateRecordingTest, CourtyardAEveryBurstWithin5Percent) {
   ExpectPerBurst(testing::Courtyard(), 0.10, 0.90);
 }
 
-TEST(EstimateRecordingTest, CourtyardBEveryBurstWithin5PercentButTheOvercastOne) {
-  // Issue 37's third recording. Measured: bursts 0, 1, 3 and 4 within 3.4% (they were 6.6%, 2.1%,
-  // 2.7% and 14.9% before the sky's fill rule and the physical sky, docs/estimation.md item 7).
-  // The overcast burst 2 has E_sun 7.8% low in red: its sun is a quarter of the sunlit ground's
-  // light, so a 1% model error is a 4% error in E_sun; the confidence (AUC 0.96) and the split
-  // check (tests/residuals_recording_test.cc) say so. Open: held to 8.5% and the 90th percentile
-  // (10.4%) to 11% until it is fixed.
-  ExpectPerBurst(testing::CourtyardB(), 0.11, 0.90, {{2, 0.085}});
+TEST(EstimateRecordingTest, CourtyardBEveryBurstWithin5Percent) {
+  // Issue 37's third recording. Measured: worst 4.1% (the overcast burst 2's E_sun red, 5.7%
+  // before its weak sun took the clear frames' colour, docs/estimation.md item 8), the others
+  // within 3.4% (6.6%, 2.1%, 2.7% and 14.9% before the sky's fill rule and the physical sky,
+  // item 7); the 90th percentile 6.7%; 10 frames of 500 beyond 10%, ranked with AUC 0.94.
+  ExpectPerBurst(testing::CourtyardB(), 0.10, 0.90);
 }
 
 TEST(EstimateRecordingTest, CourtyardCEveryBurstWithin5Percent) {
