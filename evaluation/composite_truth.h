@@ -37,6 +37,7 @@ struct CompositeFidelity {
   size_t false_shadow_pixels = 0;  // of them, where only daylit drew a shadow
   double frame_shadow_error = 0.0;  // the frame itself (before compositing) against the truth
                                     // without objects, on the same pixels: the camera's own share
+  size_t dark_pixels = 0;           // left out: black in the truth (below 1/1000 of the median)
 };
 
 // All images camera-size, linear RGB row-major from the top; `mask` 8-bit.

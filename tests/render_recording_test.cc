@@ -93,5 +93,16 @@ TEST(RenderRecordingTest, CourtyardCCompositesMatchThePathTracedFramesWithObject
   ExpectIssue18Bars(volume);
 }
 
+// courtyard-b's 10 truth frames (Florence in September: a portico whose back wall is lit by
+// reflected light, a low morning sun, an overcast burst).
+TEST(RenderRecordingTest, CourtyardBCompositesMatchThePathTracedFramesWithObjects) {
+  std::string why;
+  const auto gl = HeadlessGlContext::Create(&why);
+  ASSERT_NE(gl, nullptr) << why;
+  const Fidelity volume = Composite(testing::CourtyardB(), {}, "volume");
+  ASSERT_EQ(volume.frames, 10);
+  ExpectIssue18Bars(volume);
+}
+
 }  // namespace
 }  // namespace daylit::render
