@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The main job on a recording (default: the bundled courtyard-a), headless. Sets up and builds
-# first. Writes into OUT (default out/<recording name>/):
+# first: only the packages and the one target (`daylit`) it needs (scripts/build.sh --main). Writes into OUT (default out/<recording name>/):
 #   info.txt  what `daylit info` says of the recording (validation, frames, sun path, surfaces)
 #   sun.csv   the sun for every frame (topocentric zenith/azimuth and the scene vector)
 #   sun.png   the sun's elevation and azimuth over the recording
@@ -17,7 +17,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 recording=${1:-recordings/courtyard-a}
-bash scripts/build.sh >/dev/null
+bash scripts/build.sh --main >/dev/null
 daylit=build/bin/daylit
 name=$(basename "$(realpath "$recording")")
 out=${2:-out/$name}

@@ -2,19 +2,31 @@
 # Installs every Debian package daylit uses (build, tests, benchmarks, headless GL,
 # video, Chromium for the browser viewer's test), then the viewer's npm packages (three.js and
 # the test's playwright-core and pngjs, pinned in web/package-lock.json) into web/node_modules.
+#   scripts/setup.sh          everything (scripts/test.sh)
+#   scripts/setup.sh --main   only what building and running the `daylit` command needs (the
+#                             main job, scripts/replay.sh): no test, benchmark, sanitizer or
+#                             browser packages, no npm
 # Idempotent and quiet: when everything is already installed it only checks.
 # Run as root (or with sudo available) on Debian bookworm.
 set -euo pipefail
 
+main_only=0
+if [ "${1:-}" = "--main" ]; then main_only=1; fi
+
+# Building and running `daylit` (headless GL through Mesa's EGL, video through libavcodec).
 packages=(
-  build-essential cmake pkgconf git
+  build-essential cmake pkgconf
   libopencv-dev libavformat-dev libavcodec-dev libavutil-dev libswscale-dev libv4l-dev libgeographiclib-dev libceres-dev libeigen3-dev libunwind-dev
   libglm-dev libglfw3-dev libegl-dev libgl-dev libgles-dev libepoxy-dev libegl-mesa0
   libgl1-mesa-dri libgbm-dev libopenexr-dev libimath-dev libembree-dev libtbb-dev
-  libgtest-dev libgmock-dev libbenchmark-dev nlohmann-json3-dev libcli11-dev
+  nlohmann-json3-dev libcli11-dev
   libcpp-httplib-dev libspdlog-dev libfmt-dev libtinyobjloader-dev libtinygltf-dev libstb-dev liberfa-dev
-  ffmpeg xvfb xauth clang libclang-rt-14-dev chromium faketime
 )
+# The tests, benchmarks, sanitizer and fuzz builds, the window tests' X server, the viewer's
+# browser test, the live tests' faked clock.
+if [ "$main_only" -eq 0 ]; then
+  packages+=(git libgtest-dev libgmock-dev libbenchmark-dev ffmpeg xvfb xauth clang libclang-rt-14-dev chromium faketime)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -24,7 +36,9 @@ for p in "${packages[@]}"; do
 done
 # Node.js ≥ 20 runs the npm registry's packages (playwright-core needs it); Debian's own is 18,
 # so it is only installed where there is none, and checked below.
-if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then missing+=(nodejs npm); fi
+if [ "$main_only" -eq 0 ] && { ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; }; then
+  missing+=(nodejs npm)
+fi
 
 # The viewer's packages, exactly as web/package-lock.json pins them, once per change of it.
 install_web() {
@@ -53,7 +67,7 @@ install_web() {
 }
 
 if [ ${#missing[@]} -eq 0 ]; then
-  install_web
+  if [ "$main_only" -eq 0 ]; then install_web; fi
   exit 0
 fi
 
@@ -76,4 +90,4 @@ if ! { "${sudo_cmd[@]}" apt-get update -q &&
 fi
 rm -f "$log"
 echo "setup: done" >&2
-install_web
+if [ "$main_only" -eq 0 ]; then install_web; fi
