@@ -8,6 +8,7 @@
 #include <string>
 
 #include <atomic>
+#include <cstring>
 #include <fstream>
 #include <system_error>
 
@@ -33,15 +34,24 @@ void RemoveStaleTemporaries(const std::filesystem::path& path) {
   }
 }
 
-std::filesystem::path TemporarySibling(const std::filesystem::path& path) {
+std::filesystem::path ThroughSymlinks(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_symlink(path, ec)) return path;
+  const std::filesystem::path target = std::filesystem::weakly_canonical(path, ec);
+  return ec ? path : target;
+}
+
+std::filesystem::path TemporarySibling(const std::filesystem::path& given) {
   static std::atomic<unsigned> counter{0};
+  const std::filesystem::path path = ThroughSymlinks(given);
   RemoveStaleTemporaries(path);
   std::filesystem::path tmp = path;
   tmp += fmt::format(".tmp-{}-{}", static_cast<long>(::getpid()), counter++);
   return tmp;
 }
 
-void CommitTemporary(const std::filesystem::path& from, const std::filesystem::path& to) {
+void CommitTemporary(const std::filesystem::path& from, const std::filesystem::path& given) {
+  const std::filesystem::path to = ThroughSymlinks(given);
   std::error_code ec, removed;
   std::filesystem::rename(from, to, ec);
   if (ec) {
@@ -63,7 +73,10 @@ void WriteFileAtomically(const std::filesystem::path& path,
     write(out);
     out.flush();
     if (!out) {
-      ThrowInputError("{}: write failed (disk full?)", path.string());
+      // The file could be made, so its folder is writable: a write that fails then is the
+      // machine's (a full disk, an I/O error), not the input's.
+      const int error = errno;
+      ThrowSystemError("{}: write failed: {}", path.string(), error != 0 ? std::strerror(error) : "no space or I/O error");
     }
   } catch (...) {
     std::filesystem::remove(tmp, ec);

@@ -25,7 +25,12 @@ std::filesystem::path TemporarySibling(const std::filesystem::path& path);
 // Removes the "<path>.tmp-<pid>-..." files beside `path` whose process <pid> is gone.
 void RemoveStaleTemporaries(const std::filesystem::path& path);
 
-// Renames `from` to `to`, replacing it; throws InputError naming both on failure.
+// `path` itself, or where it leads if it is a symlink: the writers above write the file a link
+// names and leave the link in place (TemporarySibling and CommitTemporary both follow it).
+std::filesystem::path ThroughSymlinks(const std::filesystem::path& path);
+
+// Renames `from` to `to` (through a symlink `to`), replacing it; throws InputError naming both on
+// failure.
 void CommitTemporary(const std::filesystem::path& from, const std::filesystem::path& to);
 
 }  // namespace daylit

@@ -95,6 +95,7 @@ struct Scene {
   RigidPose cam_from_world;
   std::optional<PoseFit> pose_fit;  // set when the pose was solved from correspondences
   capture::CameraResponse response;
+  std::optional<std::filesystem::path> response_table;  // {"curve": "response.csv"}
   double exposure = 1.0;
 
   std::optional<EnvMapSpec> envmap;
@@ -115,6 +116,16 @@ struct SceneSun {
   glm::dvec3 dir{0.0, 0.0, 1.0};
 };
 SceneSun SunAt(const Scene& scene, const UtcTime& utc);
+
+// Every file and folder the scene reads: scene.json, the model, the diffuse mask, the response
+// table, the env map, the video and frames.csv (or every frame's image), the objects' mesh files
+// and the ground truth (its CSV and its folder, whose every file counts). The commands refuse to
+// write an output over any of them (apps/daylit/outputs.cc).
+struct SceneInputs {
+  std::vector<std::filesystem::path> files;
+  std::vector<std::filesystem::path> folders;  // everything inside them is read
+};
+SceneInputs InputsOf(const Scene& scene);
 
 // Loads `path` (a scene.json, or a recording folder holding one), the OBJ model it names and
 // its frames.csv, and checks every field. Throws InputError "<file>: <field>: <problem>".

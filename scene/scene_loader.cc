@@ -94,7 +94,7 @@ void LoadModelAndSurfaces(const JsonField& root, Scene* scene) {
   }
 }
 
-capture::CameraResponse LoadResponse(const Scene& scene, const JsonField& field) {
+capture::CameraResponse LoadResponse(Scene& scene, const JsonField& field) {
   capture::CameraResponse response;
   if (field.IsString()) {
     const std::string name = field.String();
@@ -108,7 +108,9 @@ capture::CameraResponse LoadResponse(const Scene& scene, const JsonField& field)
   if (!field.IsObject()) field.Fail("expected \"linear\", \"srgb\", {\"gamma\": g} or {\"curve\": \"response.csv\"}");
   if (auto curve = field.Find("curve")) {
     response.curve = capture::ResponseCurve::kTable;
-    response.table = capture::ReadResponseTable(RequireFile(scene, *curve));
+    const fs::path table = RequireFile(scene, *curve);
+    response.table = capture::ReadResponseTable(table);
+    scene.response_table = table;
     return response;
   }
   const JsonField gamma = field.Get("gamma");
@@ -393,6 +395,25 @@ void LoadGroundTruth(const JsonField& root, Scene* scene) {
 }  // namespace
 
 fs::path FramesSpec::ImagePath(int index) const { return capture::FramePath(image_pattern, index); }
+
+SceneInputs InputsOf(const Scene& scene) {
+  SceneInputs in;
+  in.files = {scene.file, scene.model.file};
+  if (scene.diffuse_mask) in.files.push_back(*scene.diffuse_mask);
+  if (scene.response_table) in.files.push_back(*scene.response_table);
+  if (scene.envmap) in.files.push_back(scene.envmap->file);
+  if (scene.frames.kind == FrameSourceKind::kVideo) in.files.push_back(scene.frames.video);
+  if (scene.frames.kind != FrameSourceKind::kDevice) in.files.push_back(scene.frames.timestamps);
+  if (scene.frames.kind == FrameSourceKind::kImages && scene.frame_times) {
+    for (const capture::FrameTime& t : scene.frame_times->frames) in.files.push_back(scene.frames.ImagePath(t.index));
+  }
+  for (const VirtualObject& o : scene.objects) {
+    if (o.kind == MeshKind::kFile) in.files.push_back(o.file);
+  }
+  if (scene.groundtruth.lighting) in.files.push_back(*scene.groundtruth.lighting);
+  if (scene.groundtruth.composites) in.folders.push_back(*scene.groundtruth.composites);
+  return in;
+}
 
 std::unique_ptr<capture::FrameSource> OpenFrameSource(const Scene& scene) {
   switch (scene.frames.kind) {

@@ -973,6 +973,75 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
   }
 }
 
+// An output never lands on what the run reads (issue 43): `--out` naming the recording's video,
+// env map, model, frames.csv, ground truth or scene files, one of a command's input images, or a
+// symlink to any of them, is refused with exit 2 before any work, and every input keeps its bytes.
+TEST(CliTest, AnOutputThatNamesAnInputIsRefusedAndTheInputIsUntouched) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_inputs_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const fs::path rec = dir / "rec", linked = dir / "linked";
+  fs::create_directories(rec);
+  fs::create_directories(linked);
+  for (const char* f : {"scene.json", "model.obj", "frames.csv", "video.mp4", "envmap.exr", "groundtruth.csv"}) {
+    fs::copy_file(fs::path(kRecording) / f, rec / f);
+  }
+  fs::create_symlink(fs::path(kRecording) / "groundtruth", rec / "groundtruth");
+  // A recording whose video is a symlink into the first one: --out through the link is the video.
+  for (const char* f : {"scene.json", "model.obj", "frames.csv", "envmap.exr", "groundtruth.csv"}) {
+    fs::copy_file(rec / f, linked / f);
+  }
+  fs::create_symlink(fs::path(kRecording) / "groundtruth", linked / "groundtruth");
+  fs::create_symlink(rec / "video.mp4", linked / "video.mp4");
+  fs::create_directories(dir / "images");
+  const fs::path b0 = dir / "images" / "b0.png";
+  cv::imwrite(b0.string(), cv::Mat(16, 16, CV_8UC3, cv::Scalar(40, 80, 120)));
+  cv::imwrite((dir / "images" / "b1.png").string(), cv::Mat(16, 16, CV_8UC3, cv::Scalar(80, 160, 240)));
+  const fs::path page = dir / "page.md.in";
+  WriteFileAtomically(page, "figure {{a}}\n");
+  const auto bytes = [](const fs::path& p) { return ReadTextFile(p); };
+  std::map<fs::path, std::string> before;
+  for (const fs::path& p : {rec / "scene.json", rec / "model.obj", rec / "frames.csv", rec / "video.mp4", rec / "envmap.exr",
+                            rec / "groundtruth.csv", b0, page}) {
+    before[p] = bytes(p);
+  }
+  const std::string cache = " --cache " + std::string(DAYLIT_BINARY_DIR) + "/test-cache/courtyard-a";
+  const std::string r = rec.string();
+  const BadCall calls[] = {
+      {"replay " + r + cache + " --frames 5 --out " + r + "/video.mp4", "names a file this run reads"},
+      {"replay " + linked.string() + cache + " --frames 5 --out " + linked.string() + "/video.mp4", "names a file this run reads"},
+      {"replay " + linked.string() + cache + " --frames 5 --out " + r + "/video.mp4", "names a file this run reads"},
+      {"relight-env " + r + cache + " --frame 0 --out " + r + "/envmap.exr", "names a file this run reads"},
+      {"calibrate-scene " + r + cache + " --out " + r + "/model.obj", "names a file this run reads"},
+      {"calibrate-scene " + r + cache + " --out " + r + "/frames.csv", "names a file this run reads"},
+      {"calibrate-scene " + r + cache + " --out " + dir.string() + "/s.json --figures " + r + "/scene.json",
+       "names a file this run reads"},
+      {"estimate " + r + cache + " --out " + r + "/groundtruth.csv", "names a file this run reads"},
+      {"estimate " + r + cache + " --residuals " + r + "/groundtruth", "which this run reads"},
+      {"render " + r + cache + " --frame 0 --out " + r + "/envmap.exr", "names a file this run reads"},
+      {"sunpos --scene " + r + " --frames --out " + r + "/frames.csv", "names a file this run reads"},
+      {"calibrate-response " + b0.string() + " " + (dir / "images" / "b1.png").string() + " --times 1,2 --out " + b0.string(),
+       "names a file this run reads"},
+      {"calibrate-response " + b0.string() + " " + (dir / "images" / "b1.png").string() + " --times 1,2 --out " +
+           (dir / "images" / "b0.csv").string(),
+       "names a file this run reads"},  // its plot, b0.png
+      {"results " + page.string() + " " + dir.string() + " --out " + page.string(), "names a file this run reads"},
+  };
+  for (const BadCall& call : calls) {
+    const CliRun run = Daylit(call.args);  // NOLINT
+    EXPECT_EQ(run.exit_code, 2) << call.args << "\n" << run.err;
+    EXPECT_NE(run.err.find(call.error), std::string::npos) << call.args << "\n" << run.err.substr(0, 2000);
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << call.args << "\n" << run.err.substr(0, 2000);
+  }
+  for (const auto& [path, content] : before) EXPECT_TRUE(bytes(path) == content) << path << " changed";
+  EXPECT_TRUE(fs::is_symlink(linked / "video.mp4"));
+  for (const fs::path& folder : {rec, linked, dir / "images"}) {
+    for (const auto& entry : fs::directory_iterator(folder)) {
+      EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
+    }
+  }
+  fs::remove_all(dir);
+}
+
 // calibrate-scene on one burst (--frames 100): one time of day, so north alone is fitted and the
 // output says why; written outside the recording, its paths lead back to the recording's files;
 // what it cannot fit is refused by name.
@@ -1001,6 +1070,17 @@ TEST(CliTest, CalibrateSceneFitsNorthOnOneBurstAndWritesAResolvableScene) {
   const CliRun info = Daylit("--allow-outside-paths info " + (dir / "scene.json").string() + " --no-shadow-check");
   EXPECT_EQ(info.exit_code, 0) << info.err;
   EXPECT_FALSE(fs::exists(fs::path(kRecording) / "scene.json.bak"));
+  // Written in place twice: each run keeps the scene it replaced (.bak, then .bak.1), so the
+  // user's first scene is never lost.
+  const std::string first = ReadTextFile(dir / "scene.json");
+  for (int i = 0; i < 2; ++i) {
+    const CliRun again = Daylit("--allow-outside-paths calibrate-scene " + (dir / "scene.json").string() + cache +
+                                " --frames 10 --out " + (dir / "scene.json").string());
+    ASSERT_EQ(again.exit_code, 0) << again.err;
+  }
+  EXPECT_EQ(ReadTextFile(dir / "scene.json.bak"), first);
+  EXPECT_TRUE(fs::is_regular_file(dir / "scene.json.bak.1"));
+  EXPECT_FALSE(fs::exists(dir / "scene.json.bak.2"));
 
   const CliRun bad = Daylit("calibrate-scene " + kRecording + cache + " --what sky --out " + (dir / "x.json").string());
   EXPECT_EQ(bad.exit_code, 2);

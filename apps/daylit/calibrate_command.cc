@@ -53,6 +53,12 @@ void RunCalibrateResponse(const ResponseOptions& o) {
       }
     }
   }
+  {
+    std::vector<std::filesystem::path> inputs(o.images.begin(), o.images.end());
+    const std::filesystem::path png = std::filesystem::path(o.out).replace_extension(".png");
+    RefuseInputsAsOutputs(inputs, {}, {{"--out", o.out}, {"--out's plot", png}});
+    RefuseSharedOutputs({{"--out", o.out}, {"--out's plot", png}});
+  }
   std::vector<cv::Mat> images;
   for (size_t i = 0; i < o.images.size(); ++i) {
     if (!(o.seconds[i] > 0.0f)) ThrowInputError("--times: {} s for {} is not an exposure time", o.seconds[i], o.images[i]);
@@ -101,10 +107,12 @@ struct CameraOptions {
 void RunCalibrateCamera(const CameraOptions& o) {
   capture::Chessboard board;
   char x = 0;
-  if (std::sscanf(o.board.c_str(), "%d%c%d", &board.inner_columns, &x, &board.inner_rows) != 3 || x != 'x' ||
-      board.inner_columns < 2 || board.inner_rows < 2) {
+  int used = 0;
+  if (std::sscanf(o.board.c_str(), "%d%c%d%n", &board.inner_columns, &x, &board.inner_rows, &used) != 3 || x != 'x' ||
+      static_cast<size_t>(used) != o.board.size() || board.inner_columns < 2 || board.inner_rows < 2) {
     ThrowInputError("--board: '{}' is not COLSxROWS of inner corners, e.g. 9x6", o.board);
   }
+  RefuseInputsAsOutputs(std::vector<std::filesystem::path>(o.images.begin(), o.images.end()), {}, {{"--out", o.out}});
   // OpenCV's corner search allocates per corner and takes minutes on a huge pattern; a printed
   // board has a few dozen corners a side.
   constexpr int kMaxCorners = 100;

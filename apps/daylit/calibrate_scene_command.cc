@@ -103,6 +103,14 @@ void RunCalibrateSceneCommand(const CalibrateSceneOptions& o) {
   const fs::path out = o.out;
   RequireWritable("--out", out), RequireWritable("--figures", o.figures);
   const scene::Scene scene = scene::LoadScene(o.recording);
+  {
+    // --out may be the scene.json itself (an in-place edit that keeps the old one), nothing else
+    // the recording reads.
+    scene::SceneInputs inputs = scene::InputsOf(scene);
+    std::error_code ec;
+    if (fs::exists(out, ec) && fs::equivalent(out, scene.file, ec)) inputs.files.erase(inputs.files.begin());
+    RefuseInputsAsOutputs(inputs.files, inputs.folders, {{"--out", out}, {"--figures", o.figures}});
+  }
   const fs::path dir = bake::CacheDir(scene, o.cache);
   bool loaded = false;
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, dir, &loaded);
@@ -163,8 +171,10 @@ void RunCalibrateSceneCommand(const CalibrateSceneOptions& o) {
   }
   const std::string json = CorrectedSceneJson(scene, fit, out);
   if (fs::exists(out) && fs::equivalent(out, scene.file)) {
-    const fs::path backup = fs::path(scene.file).concat(".bak");
-    fs::copy_file(scene.file, backup, fs::copy_options::overwrite_existing);
+    // Every earlier version kept: scene.json.bak, then .bak.1, .bak.2, ...
+    fs::path backup = fs::path(scene.file).concat(".bak");
+    for (int n = 1; fs::exists(backup) || fs::is_symlink(backup); ++n) backup = fs::path(scene.file).concat(fmt::format(".bak.{}", n));
+    fs::copy_file(scene.file, backup);
     Log().info("kept the old scene as {}", backup.string());
   }
   WriteFileAtomically(out, json);

@@ -10,6 +10,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "scene/scene.h"
+
 namespace daylit::app {
 
 void AddSunposCommand(CLI::App& app);
@@ -31,6 +33,18 @@ void AddResultsCommand(CLI::App& app);
 // before any work: `estimate --out y.csv --plot y.csv` would write the plot over the table.
 // Empty paths (an output not asked for) are skipped.
 void RefuseSharedOutputs(const std::vector<std::pair<std::string, std::filesystem::path>>& outputs);
+
+// Throws InputError when an output (option or what it names, path) is one of the files the run
+// reads, `inputs` (the recording's: scene::InputsOf; or the command's own input files), or lies in
+// one of the folders it reads, `input_folders`, compared through symlinks, before any work:
+// `replay REC --out REC/video.mp4` would write the composite over the video it reads. Empty paths
+// are skipped.
+void RefuseInputsAsOutputs(const std::vector<std::filesystem::path>& inputs,
+                           const std::vector<std::filesystem::path>& input_folders,
+                           const std::vector<std::pair<std::string, std::filesystem::path>>& outputs);
+// The same with a scene's inputs.
+void RefuseInputsAsOutputs(const scene::Scene& scene,
+                           const std::vector<std::pair<std::string, std::filesystem::path>>& outputs);
 
 // Throws InputError naming `option` unless `path` can be written: its folder exists and may be
 // written to, and it is not itself a folder. Called before any work, so that a bake or a run is

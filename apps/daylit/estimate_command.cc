@@ -45,6 +45,9 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
                        {"the bursts' table", evaluation::BurstsCsvPath(o.out)}, {"--figures", o.figures}});
   RequireWritable("--out", o.out), RequireWritable("--plot", plot), RequireWritable("--figures", o.figures);
   const scene::Scene scene = scene::LoadScene(o.recording);
+  RefuseInputsAsOutputs(scene, {{"--out", o.out}, {"--plot (or the --out's .png)", plot},
+                                {"the bursts' table", evaluation::BurstsCsvPath(o.out)}, {"--figures", o.figures},
+                                {"--residuals", o.residuals}});
   // The frames first: a camera that is not there is an error now, not after the bake.
   std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
   const std::filesystem::path dir = bake::CacheDir(scene, o.cache);

@@ -1,7 +1,9 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstddef>
+#include <iterator>
 #include <filesystem>
 #include <string>
 #include <system_error>
@@ -30,6 +32,53 @@ void RefuseSharedOutputs(const std::vector<std::pair<std::string, std::filesyste
                       outputs[j].first, outputs[i].second.string());
     }
   }
+}
+
+namespace {
+
+// `path` absolute, through every symlink that exists (the final name included), normalised.
+std::filesystem::path Resolved(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path p = fs::weakly_canonical(fs::absolute(path), ec);
+  return ec ? fs::absolute(path).lexically_normal() : p;
+}
+
+// Whether `path` is `folder` or lies inside it (both resolved).
+bool Within(const std::filesystem::path& path, const std::filesystem::path& folder) {
+  auto [f, p] = std::mismatch(folder.begin(), folder.end(), path.begin(), path.end());
+  return f == folder.end() || (f->empty() && std::next(f) == folder.end());
+}
+
+}  // namespace
+
+void RefuseInputsAsOutputs(const std::vector<std::filesystem::path>& inputs,
+                           const std::vector<std::filesystem::path>& input_folders,
+                           const std::vector<std::pair<std::string, std::filesystem::path>>& outputs) {
+  std::vector<std::filesystem::path> files, folders;
+  for (const auto& f : inputs) files.push_back(Resolved(f));
+  for (const auto& f : input_folders) folders.push_back(Resolved(f));
+  for (const auto& [option, path] : outputs) {
+    if (path.empty()) continue;
+    const std::filesystem::path out = Resolved(path);
+    for (size_t i = 0; i < files.size(); ++i) {
+      if (out != files[i]) continue;
+      ThrowInputError("{}: {} names a file this run reads ({}): daylit does not write over its input (name another file)",
+                      option, path.string(), inputs[i].string());
+    }
+    for (size_t i = 0; i < folders.size(); ++i) {
+      if (!Within(out, folders[i])) continue;
+      ThrowInputError("{}: {} lies in {}, which this run reads: daylit does not write into its input (name another "
+                      "folder)",
+                      option, path.string(), input_folders[i].string());
+    }
+  }
+}
+
+void RefuseInputsAsOutputs(const scene::Scene& scene,
+                           const std::vector<std::pair<std::string, std::filesystem::path>>& outputs) {
+  const scene::SceneInputs in = scene::InputsOf(scene);
+  RefuseInputsAsOutputs(in.files, in.folders, outputs);
 }
 
 void RequireWritable(const std::string& option, const std::filesystem::path& path) {

@@ -217,6 +217,7 @@ void RelightVideo(const RelightOptions& o, const scene::Scene& scene, const bake
 void RunRelight(const RelightOptions& o) {
   CheckRelightOptions(o);
   const scene::Scene scene = scene::LoadScene(o.recording);
+  RefuseInputsAsOutputs(scene, {{"--out", o.out}});
   if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
   const FrameRange range = ParseFrameRange(scene, o.frames);
   const size_t position = o.frame ? scene::FramePosition(scene, *o.frame, "--frame") : 0;

@@ -29,6 +29,13 @@ void RunRelightEnv(const RelightEnvOptions& o) {
     ThrowInputError("--out: {} must end in .exr (its preview is written beside it as .png)", o.out);
   }
   const scene::Scene scene = scene::LoadScene(o.recording);
+  {
+    std::filesystem::path preview = o.out, strip = o.out;
+    preview.replace_extension(".png");
+    strip.replace_extension();
+    strip += "_vs_truth.png";
+    RefuseInputsAsOutputs(scene, {{"--out", o.out}, {"--out's preview", preview}, {"--out's comparison", strip}});
+  }
   if (!scene.envmap) ThrowInputError("{}: envmap: needed to relight it", scene.file.string());
   const size_t position = scene::FramePosition(scene, o.frame, "--frame");
   bool loaded = false;

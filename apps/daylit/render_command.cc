@@ -38,6 +38,7 @@ void RunRender(const RenderOptions& o) {
   if (ext != ".png" && ext != ".exr") ThrowInputError("--out: {} must end in .png or .exr", o.out);
   RequireWritable("--out", out);
   const scene::Scene scene = scene::LoadScene(o.recording);
+  RefuseInputsAsOutputs(scene, {{"--out", out}});
   const size_t position = scene::FramePosition(scene, o.frame, "--frame");
   render::FrameRendererOptions options;
   options.lights = render::ParseLighting(o.lighting, "--lighting");

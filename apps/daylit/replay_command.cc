@@ -243,6 +243,14 @@ void RunReplay(const ReplayOptions& o) {
   if (o.frames && *o.frames < 1) ThrowInputError("--frames: {} is not a number of frames", *o.frames);
   const fs::path dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
   scene::Scene scene = scene::LoadScene(o.recording);
+  {
+    std::vector<std::pair<std::string, fs::path>> outputs = {{"--out", out}, {"--screenshot", o.screenshot}};
+    for (const char* beside : {"estimates.csv", "bursts.csv", "lighting.png", "report.txt", "figures.json", "fidelity.csv",
+                               "fidelity.png", "worst_vs_truth.png"}) {
+      outputs.emplace_back(fmt::format("--out's folder ({})", beside), dir / beside);
+    }
+    RefuseInputsAsOutputs(scene, outputs);
+  }
   if (o.calibrate_s > 0.0 && !o.live) ThrowInputError("--calibrate: only for daylit live (a recording: daylit calibrate-scene)");
   if (o.live && scene.frames.kind != scene::FrameSourceKind::kDevice) {
     ThrowInputError("--scene: {}: frames name recorded frames, not a camera; replay them with daylit replay", scene.file.string());

@@ -21,6 +21,7 @@ struct ResultsOptions {
 };
 
 void RunResults(const ResultsOptions& o) {
+  RefuseInputsAsOutputs({o.page_template}, {o.measured}, {{"--out", o.out}});
   std::ifstream in(o.page_template, std::ios::binary);
   if (!in) ThrowInputError("{}: cannot read the template", o.page_template);
   std::ostringstream text;

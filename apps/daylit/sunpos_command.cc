@@ -194,9 +194,15 @@ void AddSunposCommand(CLI::App& app) {
       ThrowInputError("{}", why);
     }
     RefuseSharedOutputs({{"--out", o.out}, {"--plot", o.plot}});
-    if (!o.csv_in.empty()) return RunBatch(o);
+    if (!o.csv_in.empty()) {
+      RefuseInputsAsOutputs({o.csv_in}, {}, {{"--out", o.out}});
+      return RunBatch(o);
+    }
     std::optional<scene::Scene> loaded;
-    if (!o.scene.empty()) loaded = scene::LoadScene(o.scene);
+    if (!o.scene.empty()) {
+      loaded = scene::LoadScene(o.scene);
+      RefuseInputsAsOutputs(*loaded, {{"--out", o.out}, {"--plot", o.plot}});
+    }
     if (o.frames) return RunFrames(o, *loaded);
     if (o.time.empty()) ThrowInputError("--time is required (or use --csv, or --scene with --frames)");
     if (!loaded && (!o.lat || !o.lon)) ThrowInputError("--lat and --lon are required without --scene");
