@@ -215,6 +215,7 @@ void RunGltf(const uint8_t* data, size_t size) {
   scene::VirtualObject object;
   object.kind = scene::MeshKind::kFile;
   object.file = Scratch() / (binary ? "object.glb" : "object.gltf");
+  object.resource_root = Scratch();  // a uri that climbs out is refused, as in a recording
   WriteBytes(object.file, data, size);
   ExpectOnlyInputErrors("gltf", [&] {
     const scene::Mesh mesh = scene::ObjectMesh(object);
@@ -252,6 +253,7 @@ void SeedsGltf(const fs::path& dir) {
     base64 += i + 2 < buffer.size() ? kAlphabet[n & 63] : '=';
   }
   WriteText(dir / "embedded.gltf", gltf("data:application/octet-stream;base64," + base64));
+  WriteText(dir / "escaping.gltf", gltf("%2e%2e/%2E%2e/../etc/passwd"));
   // The same as .glb: header, a JSON chunk padded with spaces, a BIN chunk.
   std::string json = gltf("");
   while (json.size() % 4 != 0) json += ' ';

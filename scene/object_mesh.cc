@@ -203,14 +203,44 @@ void AddPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& primi
   }
 }
 
+// The files a glTF names (buffers, images), as tinygltf opens them: joined to the glTF's folder
+// and percent-decoded by tinygltf, then held to `root` here (lexically, as scene.json's paths
+// are), so that a uri "../../etc/passwd" or "%2e%2e/..." is refused, not read. No "~" expansion.
+struct GltfFiles {
+  std::filesystem::path root;  // empty: anywhere
+  std::string refused;         // the first path refused
+
+  bool Allows(const std::string& file) {
+    if (root.empty()) return true;
+    const std::filesystem::path rel = std::filesystem::absolute(file).lexically_normal().lexically_relative(root);
+    if (!rel.empty() && *rel.begin() != "..") return true;
+    if (refused.empty()) refused = file;
+    return false;
+  }
+  static bool Exists(const std::string& file, void* self) {
+    return static_cast<GltfFiles*>(self)->Allows(file) && tinygltf::FileExists(file, nullptr);
+  }
+  static std::string Expand(const std::string& file, void*) { return file; }
+  static bool Read(std::vector<unsigned char>* out, std::string* err, const std::string& file, void* self) {
+    return static_cast<GltfFiles*>(self)->Allows(file) && tinygltf::ReadWholeFile(out, err, file, nullptr);
+  }
+  static bool Write(std::string*, const std::string&, const std::vector<unsigned char>&, void*) { return false; }
+};
+
 // A glTF 2.0 file's triangles in its default scene, node transforms applied, in scene
-// coordinates (AddPrimitive).
-Mesh LoadGltfMesh(const std::filesystem::path& path) {
+// coordinates (AddPrimitive). Its buffers and images must lie in `root` (empty: anywhere).
+Mesh LoadGltfMesh(const std::filesystem::path& path, const std::filesystem::path& root) {
   tinygltf::Model model;
   tinygltf::TinyGLTF loader;
+  GltfFiles files{root.empty() ? root : std::filesystem::absolute(root).lexically_normal(), {}};
+  loader.SetFsCallbacks({&GltfFiles::Exists, &GltfFiles::Expand, &GltfFiles::Read, &GltfFiles::Write, &files});
   std::string error, warning;
   const bool ok = path.extension() == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, path.string())
                                              : loader.LoadASCIIFromFile(&model, &error, &warning, path.string());
+  if (!files.refused.empty()) {
+    ThrowInputError("{}: names '{}', outside the recording folder {} (daylit --allow-outside-paths allows it)", path.string(),
+                    files.refused, files.root.string());
+  }
   if (!ok) ThrowInputError("{}: not a glTF 2.0 file ({})", path.string(), error.empty() ? "unreadable" : error.substr(0, error.find('\n')));
   const std::string where = path.string();
   Mesh mesh;
@@ -261,7 +291,7 @@ Mesh ObjectMesh(const VirtualObject& object, int sphere_slices) {
     case MeshKind::kBox: mesh = BoxMesh(glm::vec3(object.size)); break;
     case MeshKind::kFile: {
       if (object.file.extension() != ".obj") {
-        mesh = LoadGltfMesh(object.file);
+        mesh = LoadGltfMesh(object.file, object.resource_root);
         break;
       }
       const SceneModel model = LoadObjModel(object.file);

@@ -146,6 +146,50 @@ TEST(ObjectMeshTest, GltfMeshesAreReadWithTheirNodesAndTurnedToZUp) {
   std::filesystem::remove_all(dir);
 }
 
+// A glTF's buffer uri is held to the recording folder after tinygltf joins and percent-decodes it:
+// "../" and "%2e%2e/" climbing out are refused by name (not read), one inside is read, and with
+// no root (--allow-outside-paths) the escape is followed.
+TEST(ObjectMeshTest, GltfBuffersOutsideTheRecordingAreRefused) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("daylit_gltf_root_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "rec" / "objects");
+  const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  for (const fs::path& bin : {dir / "tri.bin", dir / "rec" / "tri.bin"}) {
+    std::ofstream(bin, std::ios::binary).write(reinterpret_cast<const char*>(positions), sizeof(positions));
+  }
+  const auto gltf = [&](const std::string& name, const std::string& uri) {
+    std::ofstream(dir / "rec" / "objects" / name)
+        << R"({"asset": {"version": "2.0"}, "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}],
+              "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+              "buffers": [{"uri": ")" << uri << R"(", "byteLength": 36}],
+              "bufferViews": [{"buffer": 0, "byteLength": 36}],
+              "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}]})";
+    VirtualObject object;
+    object.kind = MeshKind::kFile;
+    object.file = dir / "rec" / "objects" / name;
+    object.resource_root = dir / "rec";
+    return object;
+  };
+  EXPECT_EQ(ObjectMesh(gltf("inside.gltf", "../tri.bin")).indices.size(), 3u);
+  for (const auto& [name, uri] : {std::pair<std::string, std::string>{"up.gltf", "../../tri.bin"},
+                                  {"encoded.gltf", "%2e%2e/%2E%2E/tri.bin"},
+                                  {"deep.gltf", "../../../../../../../../etc/passwd"}}) {
+    VirtualObject object = gltf(name, uri);
+    try {
+      ObjectMesh(object);
+      ADD_FAILURE() << uri << " was read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("outside the recording folder"), std::string::npos) << e.what();
+    }
+    if (name == "up.gltf") {
+      object.resource_root.clear();
+      EXPECT_EQ(ObjectMesh(object).indices.size(), 3u);
+    }
+  }
+  fs::remove_all(dir);
+}
+
 // A solid wall (a closed box, faces outward): a sphere whose centre is in it is refused, naming
 // the object and the wall; one beside it, or sunk halfway into the ground plane, is fine.
 TEST(ObjectMeshTest, AnObjectInsideAWallIsRefused) {

@@ -59,6 +59,9 @@ struct VirtualObject {
   glm::dvec3 rotation_deg{0.0};     // XYZ Euler, R = Rz·Ry·Rx
   glm::dvec3 scale{1.0};
   std::optional<glm::dvec3> albedo;  // override, each in [0, 1]
+  // kFile: the folder its glTF buffers and images must lie in (the recording's), empty for
+  // anywhere (daylit --allow-outside-paths).
+  std::filesystem::path resource_root;
 
   // Radius of a sphere around `position` that holds the object (mesh files: 1 m × scale until
   // the mesh is loaded by the renderer).
@@ -70,6 +73,11 @@ struct VolumeSpec {
   glm::ivec3 resolution{2};       // probes per axis, each ≥ 2
   bool defaulted = false;         // true when derived from the objects
 };
+// How far from the scene's origin, and how large, a virtual object may be (m): a courtyard's
+// statue, not a planet; past this the ray tracer's single-precision rays lose the object.
+inline constexpr double kMaxObjectExtent = 1e4;
+// The smallest size a virtual object may have (m).
+inline constexpr double kMinObjectSize = 1e-4;
 // The most probes a volume may have along one axis (scene.json, and a bake cache's gather tables).
 inline constexpr int kMaxVolumeResolution = 256;
 

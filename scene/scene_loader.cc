@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "base/error.h"
 #include "base/files.h"
@@ -275,6 +276,26 @@ void LoadFrames(const JsonField& root, Scene* scene) {
   }
 }
 
+// Every vertex of the placed mesh within kMaxObjectExtent of the origin, and the object at least
+// kMinObjectSize across.
+void CheckObjectExtent(const JsonField& o, const Mesh& mesh, const VirtualObject& object) {
+  const auto largest = [](const glm::dvec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); };
+  glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+  for (const glm::vec3& p : mesh.positions) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+      o.Fail(fmt::format("placed by its position, rotation and scale, a vertex is not a finite number"));
+    }
+    lo = glm::min(lo, glm::dvec3(p)), hi = glm::max(hi, glm::dvec3(p));
+  }
+  const double far = std::max({largest(lo), largest(hi), largest(object.position)});
+  if (far > kMaxObjectExtent) {
+    o.Fail(fmt::format("reaches {:.3g} m from the scene's origin; a virtual object must lie within {:g} m", far, kMaxObjectExtent));
+  }
+  if (largest(hi - lo) < kMinObjectSize) {
+    o.Fail(fmt::format("is {:.3g} m across; a virtual object must be at least {:g} m", largest(hi - lo), kMinObjectSize));
+  }
+}
+
 void LoadObjects(const JsonField& root, Scene* scene) {
   const std::optional<JsonField> objects = root.Find("objects");
   if (!objects) return;
@@ -298,6 +319,7 @@ void LoadObjects(const JsonField& root, Scene* scene) {
     } else {
       object.kind = MeshKind::kFile;
       object.file = RequireFile(*scene, mesh);
+      if (!allow_paths_outside) object.resource_root = scene->folder;
       const std::string ext = object.file.extension().string();
       if (ext != ".gltf" && ext != ".glb" && ext != ".obj") {
         mesh.Fail("expected a glTF 2.0 (.gltf, .glb) or OBJ (.obj) file");
@@ -316,8 +338,9 @@ void LoadObjects(const JsonField& root, Scene* scene) {
         a->Fail("each channel must be in [0, 1]");
       }
     }
-    // Read the mesh now: a damaged file is said here, by every command, not after a bake.
-    if (object.kind == MeshKind::kFile) ObjectMesh(object);
+    // Read the mesh now: a damaged file (or one that is a planet, or far away) is said here, by
+    // every command, not after a bake or inside the ray tracer.
+    CheckObjectExtent(o, ObjectMesh(object), object);
     scene->objects.push_back(object);
   }
 }

@@ -864,6 +864,22 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
   glb.WriteText("statue.glb", "glTF but not a binary glTF");
   glb.json()["objects"] = {{{"mesh", "statue.glb"}, {"position", {0, 0, 0.5}}}};
   const fs::path garbage_glb = glb.Write();
+  // Objects the ray tracer cannot hold (issue 43: Embree aborted on a 1e30 m sphere).
+  scene::testing::SceneSandbox planet("cli_planet");
+  planet.json()["objects"] = {{{"mesh", "builtin:sphere"}, {"radius", 1e30}, {"position", {0, 0, 1}}}};
+  const fs::path planet_scene = planet.Write();
+  scene::testing::SceneSandbox far("cli_far");
+  far.json()["objects"] = {{{"mesh", "builtin:box"}, {"size", {1, 1, 1}}, {"position", {1e30, 0, 0}}}};
+  const fs::path far_scene = far.Write();
+  // A glTF whose buffer climbs out of the recording, percent-encoded.
+  scene::testing::SceneSandbox escape("cli_gltf_escape");
+  escape.WriteText("statue.gltf", R"({"asset": {"version": "2.0"}, "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+      "buffers": [{"uri": "%2e%2e/%2e%2e/%2e%2e/%2e%2e/%2e%2e/%2e%2e/etc/passwd", "byteLength": 36}],
+      "bufferViews": [{"buffer": 0, "byteLength": 36}],
+      "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}]})");
+  escape.json()["objects"] = {{{"mesh", "statue.gltf"}, {"position", {0, 0, 0.5}}}};
+  const fs::path escape_scene = escape.Write();
   scene::testing::SceneSandbox live("cli_live");
   live.json()["frames"] = {{"device", "/dev/video-daylit-absent"}, {"fps", 30}};
   const fs::path live_scene = live.Write();
@@ -951,6 +967,11 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
       {"info " + no_surfaces.string(), "diffuse_surfaces: empty"},
       {"render " + garbage_glb.string() + " --frame 0 --out " + dir + "/f.png", "statue.glb: not a glTF 2.0 file"},
       {"estimate " + garbage_glb.string(), "statue.glb: not a glTF 2.0 file"},
+      {"render " + planet_scene.string() + " --frame 0 --out " + dir + "/f.png",
+       "objects[0]: reaches 1e+30 m from the scene's origin; a virtual object must lie within 10000 m"},
+      {"replay " + far_scene.string() + " --out " + dir + "/r.mp4",
+       "objects[0]: reaches 1e+30 m from the scene's origin; a virtual object must lie within 10000 m"},
+      {"info " + escape_scene.string(), "outside the recording folder"},
       // The command line itself.
       {"frobnicate", "'frobnicate' is not a daylit command"},
       {"lights " + (sandbox.dir() / "huge.exr").string() + " --out " + dir + "/l",
