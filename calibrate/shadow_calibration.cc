@@ -179,6 +179,30 @@ class ShadowScore {
     return score;
   }
 
+  // Cohen's kappa of the model's sides (V) against the frames' (σ > 0.5) over the listed pixels:
+  // 1 − observed disagreement / the disagreement of sides drawn independently with each burst's
+  // own shares, Σ_b n_b·(p_b(1 − q_b) + (1 − p_b)q_b) (p the model's sunlit share, q the frames').
+  // 0: the model's shadows tell no more about the frames' than a coin of the right bias would; 1:
+  // they agree everywhere. Chance is counted per burst, so a burst that is all sunlit in both adds
+  // nothing to the agreement.
+  double Kappa(const std::vector<std::vector<uint32_t>>& which, double north, double clock) const {
+    double wrong = 0.0, chance = 0.0;
+    std::vector<uint8_t> v;
+    for (size_t b = 0; b < bursts(); ++b) {
+      if (which[b].empty()) continue;
+      Visibility(b, which[b], north, clock, &v);
+      const std::vector<float>& sigma = observed_.bursts[b].sunlit;
+      double model_lit = 0.0, frame_lit = 0.0;
+      for (size_t i = 0; i < which[b].size(); ++i) {
+        const bool f = sigma[which[b][i]] > 0.5f, m = v[i] != 0;
+        wrong += f != m, model_lit += m, frame_lit += f;
+      }
+      const double n = static_cast<double>(which[b].size()), p = model_lit / n, q = frame_lit / n;
+      chance += n * (p * (1.0 - q) + (1.0 - p) * q);
+    }
+    return chance <= 0.0 ? 0.0 : 1.0 - wrong / chance;
+  }
+
   // The share of the listed pixels on the wrong side (|σ − V| > 0.5).
   double Disagree(const std::vector<std::vector<uint32_t>>& which, double north, double clock) const {
     size_t wrong = 0, all = 0;
@@ -478,6 +502,10 @@ FitResult FitWithScore(const scene::Scene& scene, const ShadowObservations& obse
   result.north_offset_deg = fine.north, result.clock_offset_s = fine.clock;
   result.disagree_before = score.Disagree(edges, 0.0, 0.0);
   result.disagree_after = score.Disagree(edges, fine.north, fine.clock);
+  result.kappa_after = score.Kappa(coarse, fine.north, fine.clock);
+  for (const double away : {-40.0, -20.0, 20.0, 40.0}) {
+    result.kappa_away = std::max(result.kappa_away, score.Kappa(coarse, fine.north + away, fine.clock));
+  }
 
   // The uncertainty: the jackknife over bursts (each left out in turn, searched again from the
   // fit), or with fewer than three, where the score rises by its own noise (√ of the edge count).
@@ -726,10 +754,11 @@ std::optional<ShadowCheck> CheckShadows(const scene::Scene& scene, const bake::S
   if (observed.bursts.empty()) return std::nullopt;
   FitOptions options;
   options.clock = false;
-  options.north_range_deg = 3.0, options.north_step_deg = 0.5, options.north_tolerance_deg = 0.05;
+  options.north_range_deg = kShadowCheckNorthRangeDeg, options.north_step_deg = 0.5, options.north_tolerance_deg = 0.05;
   options.coarse_stride = 4;
   const FitResult fit = FitNorthAndClock(scene, bake, caster, observed, options);
-  return ShadowCheck{fit.disagree_before, fit.north_offset_deg, fit.edge_pixels};
+  return ShadowCheck{fit.disagree_before, fit.north_offset_deg, fit.edge_pixels, fit.disagree_after, fit.kappa_after,
+                     fit.kappa_away, fit.SunSkill(), fit.at_range_edge};
 }
 
 }  // namespace daylit::calibrate

@@ -26,6 +26,20 @@ std::optional<calibrate::ShadowCheck> CheckShadowsAndSay(const scene::Scene& sce
   if (report != nullptr) {
     report->Figure("shadow_check/north_offset_deg", check->north_offset_deg);
     report->Figure("shadow_check/disagree", check->disagree);
+    report->Figure("shadow_check/kappa", check->kappa);
+    report->Figure("shadow_check/kappa_sun_turned_away", check->kappa_away);
+    report->Figure("shadow_check/sun_skill", check->sun_skill);
+    report->Figure("shadow_check/model_matches_footage", check->ModelMatchesFootage() ? 1.0 : 0.0);
+  }
+  if (!check->ModelMatchesFootage()) {
+    Log().warn("{}: the model's shadows do not match the frames' at any north within {:.0f} deg: with the frames' sun they "
+               "agree little better than with a sun turned 20-40 deg away (kappa {:.2f} against {:.2f}: {:.2f} of the rest "
+               "explained, at most {:.2f}; best north {:+.2f} deg, {:.1f}% of {} shadow-edge pixels on the wrong side); the "
+               "model, the camera pose, north or the place may not be this footage's, and every estimate rests on them: check "
+               "them (daylit render, calibrate-camera) before trusting the light",
+               scene.file.string(), calibrate::kShadowCheckNorthRangeDeg, check->kappa, check->kappa_away, check->sun_skill,
+               kShadowCheckMinSunSkill, check->north_offset_deg, 100.0 * check->disagree_best, check->edge_pixels);
+    return check;
   }
   if (std::abs(check->north_offset_deg) > kShadowCheckNorthDeg) {
     Log().warn("{}: the frames' shadows fall where the model's would with north {:+.2f} deg off ({:.1f}% of {} shadow-edge "
@@ -33,8 +47,8 @@ std::optional<calibrate::ShadowCheck> CheckShadowsAndSay(const scene::Scene& sce
                scene.file.string(), check->north_offset_deg, 100.0 * check->disagree, check->edge_pixels);
   } else {
     Log().info("shadow check: the frames' shadows agree with the model's (north within {:.2f} deg of the best, {:.1f}% of "
-               "shadow-edge pixels on the wrong side)",
-               std::abs(check->north_offset_deg), 100.0 * check->disagree);
+               "shadow-edge pixels on the wrong side; the frames' sun explains {:.2f} of the agreement a sun turned away leaves)",
+               std::abs(check->north_offset_deg), 100.0 * check->disagree, check->sun_skill);
   }
   return check;
 }

@@ -1,6 +1,8 @@
 // The quick shadow check of `daylit info` and `daylit estimate`: do the frames' shadows fall where
 // the model's do? A north (or clock) that is off moves them apart; beyond the equivalent of 0.5°
-// of north this warns and suggests `daylit calibrate-scene`.
+// of north this warns and suggests `daylit calibrate-scene`. A model that matches at no north (a
+// wrong model file, another camera's pose, the wrong place: calibrate::ShadowCheck::sun_skill)
+// is warned about as such.
 #pragma once
 
 #include <optional>
@@ -15,6 +17,7 @@
 namespace daylit::app {
 
 inline constexpr double kShadowCheckNorthDeg = 0.5;
+using calibrate::kShadowCheckMinSunSkill;
 
 // Feeds the pipeline's frames to a ShadowObserver. With `stop_at_first_sunlit_burst` it ends the
 // run once a burst (or stretch, ObserveOptions::max_burst_s) has shown the sun on the model: live
@@ -33,8 +36,9 @@ class ShadowCheckSink final : public pipeline::FrameSink {
   bool stop_at_first_ = false;
 };
 
-// Runs the check on what was observed: warns (stderr) when the model's shadows sit where a north
-// more than kShadowCheckNorthDeg off would put them; says on stderr when the footage cannot tell
+// Runs the check on what was observed: warns (stderr) when the model's shadows match the frames'
+// at no north (ModelMatchesFootage), else when they sit where a north more than
+// kShadowCheckNorthDeg off would put them; says on stderr when the footage cannot tell
 // (no clear burst). Adds shadow_check/* figures to `report` when given. Returns the check.
 std::optional<calibrate::ShadowCheck> CheckShadowsAndSay(const scene::Scene& scene, const bake::SceneBake& bake,
                                                          const scene::RayCaster& caster,
