@@ -179,14 +179,16 @@ class ShadowScore {
     return score;
   }
 
-  // Cohen's kappa of the model's sides (V) against the frames' (σ > 0.5) over the listed pixels:
-  // 1 − observed disagreement / the disagreement of sides drawn independently with each burst's
-  // own shares, Σ_b n_b·(p_b(1 − q_b) + (1 − p_b)q_b) (p the model's sunlit share, q the frames').
-  // 0: the model's shadows tell no more about the frames' than a coin of the right bias would; 1:
-  // they agree everywhere. Chance is counted per burst, so a burst that is all sunlit in both adds
-  // nothing to the agreement.
-  double Kappa(const std::vector<std::vector<uint32_t>>& which, double north, double clock) const {
-    double wrong = 0.0, chance = 0.0;
+  // The listed pixels' sides, summed over the bursts: how many, how many on the wrong side
+  // (|σ − V| > 0.5), and how many sides drawn independently with each burst's own shares would
+  // put there, Σ_b n_b·(p_b(1 − q_b) + (1 − p_b)q_b) (p the model's sunlit share, q the frames',
+  // σ > 0.5). Chance is counted per burst, so a burst that is all sunlit in both adds nothing to
+  // the agreement.
+  struct Sides {
+    double pixels = 0.0, wrong = 0.0, chance = 0.0;
+  };
+  Sides CountSides(const std::vector<std::vector<uint32_t>>& which, double north, double clock) const {
+    Sides sides;
     std::vector<uint8_t> v;
     for (size_t b = 0; b < bursts(); ++b) {
       if (which[b].empty()) continue;
@@ -194,26 +196,27 @@ class ShadowScore {
       const std::vector<float>& sigma = observed_.bursts[b].sunlit;
       double model_lit = 0.0, frame_lit = 0.0;
       for (size_t i = 0; i < which[b].size(); ++i) {
-        const bool f = sigma[which[b][i]] > 0.5f, m = v[i] != 0;
-        wrong += f != m, model_lit += m, frame_lit += f;
+        const float s = sigma[which[b][i]];
+        sides.wrong += std::abs(s - static_cast<float>(v[i])) > 0.5f, model_lit += v[i] != 0, frame_lit += s > 0.5f;
       }
       const double n = static_cast<double>(which[b].size()), p = model_lit / n, q = frame_lit / n;
-      chance += n * (p * (1.0 - q) + (1.0 - p) * q);
+      sides.pixels += n, sides.chance += n * (p * (1.0 - q) + (1.0 - p) * q);
     }
-    return chance <= 0.0 ? 0.0 : 1.0 - wrong / chance;
+    return sides;
   }
 
-  // The share of the listed pixels on the wrong side (|σ − V| > 0.5).
+  // The share of the listed pixels on the wrong side.
   double Disagree(const std::vector<std::vector<uint32_t>>& which, double north, double clock) const {
-    size_t wrong = 0, all = 0;
-    std::vector<uint8_t> v;
-    for (size_t b = 0; b < bursts(); ++b) {
-      Visibility(b, which[b], north, clock, &v);
-      const std::vector<float>& sigma = observed_.bursts[b].sunlit;
-      for (size_t i = 0; i < which[b].size(); ++i) wrong += std::abs(sigma[which[b][i]] - static_cast<float>(v[i])) > 0.5f;
-      all += which[b].size();
-    }
-    return all == 0 ? 0.0 : static_cast<double>(wrong) / static_cast<double>(all);
+    const Sides sides = CountSides(which, north, clock);
+    return sides.pixels == 0.0 ? 0.0 : sides.wrong / sides.pixels;
+  }
+
+  // Cohen's kappa of the model's sides against the frames': 1 − wrong / chance. 0: the model's
+  // shadows tell no more about the frames' than a coin of the right bias would; 1: they agree
+  // everywhere.
+  double Kappa(const std::vector<std::vector<uint32_t>>& which, double north, double clock) const {
+    const Sides sides = CountSides(which, north, clock);
+    return sides.chance <= 0.0 ? 0.0 : 1.0 - sides.wrong / sides.chance;
   }
 
  private:
@@ -758,7 +761,7 @@ std::optional<ShadowCheck> CheckShadows(const scene::Scene& scene, const bake::S
   options.coarse_stride = 4;
   const FitResult fit = FitNorthAndClock(scene, bake, caster, observed, options);
   return ShadowCheck{fit.disagree_before, fit.north_offset_deg, fit.edge_pixels, fit.disagree_after, fit.kappa_after,
-                     fit.kappa_away, fit.SunSkill(), fit.at_range_edge};
+                     fit.kappa_away};
 }
 
 }  // namespace daylit::calibrate

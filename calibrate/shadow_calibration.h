@@ -129,18 +129,10 @@ struct FitResult {
   double disagree_before = 0.0;      // share of the edge pixels on the wrong side at the scene's values
   double disagree_after = 0.0;       // and at the fitted ones
   // Cohen's kappa of the model's sunlit/shadowed sides against the frames' at the fitted values,
-  // over the compared pixels (every coarse_stride-th): the agreement beyond what sides drawn at
-  // random with the same shares would have (0.74-0.99 on the bundled recordings). A model that is
-  // not the footage's still gets 0.3-0.8 from the layout alone, so it is judged by SunSkill.
+  // over the compared pixels (every coarse_stride-th), and the highest kappa with the sun turned
+  // 20° or 40° either way from the fitted (ShadowCheck::SunSkill).
   double kappa_after = 0.0;
-  // The highest kappa with the sun turned 20° or 40° either way from the fitted: what the scene's
-  // layout alone gives (ground sunlit in both, the walls' shade in both), with no sun in it.
   double kappa_away = -1.0;
-  // How much of the agreement that a sun turned away leaves out the frames' own sun adds:
-  // (kappa_after − kappa_away) / (1 − kappa_away), a kappa with the turned sun as the chance it is
-  // measured against. 0.56-0.98 on the bundled recordings; 0.26 or less with another camera's pose
-  // (turned 8° and more) or another scene's model (docs/calibrate.md).
-  double SunSkill() const { return kappa_away >= 1.0 ? 0.0 : (kappa_after - kappa_away) / (1.0 - kappa_away); }
   bool at_range_edge = false;        // the best lies on the search range's edge: the truth may be beyond it
   // With pose refinement (FitOptions::pose): the camera's rotation (RotatedPose) that puts the
   // model's shadows and edges on the frame's, and its jackknife σ per axis.
@@ -178,27 +170,32 @@ std::string EnvMapSunBeyondRange(const scene::Scene& scene, const bake::SceneBak
 // by `north_offset_deg`.
 glm::vec3 SunWith(const scene::Scene& scene, const UtcTime& utc, double north_offset_deg, double clock_offset_s);
 
+inline constexpr double kShadowCheckNorthRangeDeg = 3.0;  // CheckShadows searches north this far either side
+// At or below this ShadowCheck::SunSkill the model is taken not to be the footage's: 0.4 is the top
+// of "fair" agreement on Landis & Koch's scale for kappa (Biometrics 33:159-174, 1977). Measured:
+// 0.55-0.98 on the bundled recordings, 0.26 or less with another camera's pose or another scene's
+// model (docs/calibrate.md).
+inline constexpr double kShadowCheckMinSunSkill = 0.4;
+
 // The share of edge pixels (those whose side changes within ±`north_range_deg`) that the model's
 // shadows put on the wrong side of the frames' ones, at the scene's own values: the quick check
 // of `info` and `estimate`, and the north offset that would fit best (north only, clock held).
-inline constexpr double kShadowCheckNorthRangeDeg = 3.0;  // CheckShadows searches north this far either side
-// At or below this share of the shadows' agreement explained by the frames' own sun
-// (calibrate::ShadowCheck::sun_skill, a kappa against a sun turned 20-40° away) the model is
-// taken not to be the footage's: 0.4 is the top of "fair" agreement on Landis & Koch's scale for
-// kappa (Biometrics 33:159-174, 1977). Measured: 0.56-0.98 on the bundled recordings, 0.26 or
-// less with another camera's pose or another scene's model (docs/calibrate.md).
-inline constexpr double kShadowCheckMinSunSkill = 0.4;
 struct ShadowCheck {
   double disagree = 0.0;
   double north_offset_deg = 0.0;
   size_t edge_pixels = 0;
   double disagree_best = 0.0;   // the share on the wrong side at the best north
-  double kappa = 0.0;           // FitResult::kappa_after: the agreement beyond chance at the best north
-  double kappa_away = 0.0;      // FitResult::kappa_away
-  double sun_skill = 0.0;       // FitResult::SunSkill: what the frames' own sun adds to the agreement
-  bool at_range_edge = false;   // the best north is the search's limit (±3°)
+  // Cohen's kappa of the sides at the best north (the agreement beyond sides drawn at random with
+  // the same shares: 0.74-0.99 on the bundled recordings), and with the sun turned 20-40° away:
+  // what the scene's layout alone gives (ground sunlit in both, the walls' shade in both), with no
+  // sun in it. A model that is not the footage's still gets 0.3-0.8 from the layout.
+  double kappa = 0.0;
+  double kappa_away = 0.0;
+  // What the frames' own sun adds to the agreement a sun turned away leaves: a kappa with the
+  // turned sun as its chance, (kappa − kappa_away) / (1 − kappa_away).
+  double SunSkill() const { return kappa_away >= 1.0 ? 0.0 : (kappa - kappa_away) / (1.0 - kappa_away); }
   // The model, pose, north and place are the footage's, as far as its shadows tell.
-  bool ModelMatchesFootage() const { return sun_skill > kShadowCheckMinSunSkill; }
+  bool ModelMatchesFootage() const { return SunSkill() > kShadowCheckMinSunSkill; }
 };
 std::optional<ShadowCheck> CheckShadows(const scene::Scene& scene, const bake::SceneBake& bake,
                                         const scene::RayCaster& caster, const ShadowObservations& observed);

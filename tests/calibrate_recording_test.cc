@@ -227,9 +227,9 @@ TEST(ShadowCheckTest, EachBundledModelMatchesItsFootage) {
     const std::optional<calibrate::ShadowCheck> check =
         calibrate::CheckShadows(c->scene, c->bake, caster, calibrate::ObserveShadows(c->scene, c->bake, caster));
     ASSERT_TRUE(check.has_value()) << c->scene.name;
-    EXPECT_TRUE(check->ModelMatchesFootage()) << c->scene.name << ": sun skill " << check->sun_skill;
-    EXPECT_GE(check->sun_skill, 0.5) << c->scene.name;
-    testing::RecordFigure(fmt::format("{}/shadow_check/sun_skill", c->scene.name), check->sun_skill);
+    EXPECT_TRUE(check->ModelMatchesFootage()) << c->scene.name << ": sun skill " << check->SunSkill();
+    EXPECT_GE(check->SunSkill(), 0.5) << c->scene.name;
+    testing::RecordFigure(fmt::format("{}/shadow_check/sun_skill", c->scene.name), check->SunSkill());
   }
 }
 

@@ -212,17 +212,18 @@ void PrintShadowCheck(const scene::Scene& scene, const std::string& cache, std::
   } else if (!check->ModelMatchesFootage()) {
     fmt::print("shadows      do not match the model's at any north within {:.0f} deg (the frames' sun explains {:.2f} of the "
                "agreement, at most {:.2f}): the model, the camera pose, north or the place may not be this footage's\n",
-               calibrate::kShadowCheckNorthRangeDeg, check->sun_skill, kShadowCheckMinSunSkill);
-    problems->push_back(fmt::format("the frames' shadows do not match the model's (sun skill {:.2f}): a wrong model, pose, north or place",
-                                    check->sun_skill));
+               calibrate::kShadowCheckNorthRangeDeg, check->SunSkill(), kShadowCheckMinSunSkill);
+    problems->push_back(fmt::format("the frames' shadows do not match the model's (sun skill {:.2f}): a wrong model, pose, "
+                                    "north or place",
+                                    check->SunSkill()));
   } else if (std::abs(check->north_offset_deg) > kShadowCheckNorthDeg) {
-    fmt::print("shadows      off: where the model's would fall with north {:+.2f} deg off; run daylit "
-               "calibrate-scene\n",
+    fmt::print("shadows      off: where the model's would fall with north {:+.2f} deg off; run daylit calibrate-scene\n",
                check->north_offset_deg);
     problems->push_back(fmt::format("the frames' shadows disagree with the model's by {:+.2f} deg of north", check->north_offset_deg));
   } else {
-    fmt::print("shadows      agree with the model's: the best north is {:+.2f} deg from the scene's ({} bursts; the frames' sun explains {:.2f} of the agreement)\n",
-               check->north_offset_deg, observed.bursts.size(), check->sun_skill);
+    fmt::print("shadows      agree with the model's: the best north is {:+.2f} deg from the scene's ({} bursts; the frames' "
+               "sun explains {:.2f} of the agreement)\n",
+               check->north_offset_deg, observed.bursts.size(), check->SunSkill());
   }
 }
 

@@ -28,7 +28,7 @@ std::optional<calibrate::ShadowCheck> CheckShadowsAndSay(const scene::Scene& sce
     report->Figure("shadow_check/disagree", check->disagree);
     report->Figure("shadow_check/kappa", check->kappa);
     report->Figure("shadow_check/kappa_sun_turned_away", check->kappa_away);
-    report->Figure("shadow_check/sun_skill", check->sun_skill);
+    report->Figure("shadow_check/sun_skill", check->SunSkill());
     report->Figure("shadow_check/model_matches_footage", check->ModelMatchesFootage() ? 1.0 : 0.0);
   }
   if (!check->ModelMatchesFootage()) {
@@ -37,7 +37,7 @@ std::optional<calibrate::ShadowCheck> CheckShadowsAndSay(const scene::Scene& sce
                "explained, at most {:.2f}; best north {:+.2f} deg, {:.1f}% of {} shadow-edge pixels on the wrong side); the "
                "model, the camera pose, north or the place may not be this footage's, and every estimate rests on them: check "
                "them (daylit render, calibrate-camera) before trusting the light",
-               scene.file.string(), calibrate::kShadowCheckNorthRangeDeg, check->kappa, check->kappa_away, check->sun_skill,
+               scene.file.string(), calibrate::kShadowCheckNorthRangeDeg, check->kappa, check->kappa_away, check->SunSkill(),
                kShadowCheckMinSunSkill, check->north_offset_deg, 100.0 * check->disagree_best, check->edge_pixels);
     return check;
   }
@@ -48,7 +48,7 @@ std::optional<calibrate::ShadowCheck> CheckShadowsAndSay(const scene::Scene& sce
   } else {
     Log().info("shadow check: the frames' shadows agree with the model's (north within {:.2f} deg of the best, {:.1f}% of "
                "shadow-edge pixels on the wrong side; the frames' sun explains {:.2f} of the agreement a sun turned away leaves)",
-               std::abs(check->north_offset_deg), 100.0 * check->disagree, check->sun_skill);
+               std::abs(check->north_offset_deg), 100.0 * check->disagree, check->SunSkill());
   }
   return check;
 }

@@ -1,7 +1,7 @@
 // The quick shadow check of `daylit info` and `daylit estimate`: do the frames' shadows fall where
 // the model's do? A north (or clock) that is off moves them apart; beyond the equivalent of 0.5°
 // of north this warns and suggests `daylit calibrate-scene`. A model that matches at no north (a
-// wrong model file, another camera's pose, the wrong place: calibrate::ShadowCheck::sun_skill)
+// wrong model file, another camera's pose, the wrong place: calibrate::ShadowCheck::SunSkill)
 // is warned about as such.
 #pragma once
 
