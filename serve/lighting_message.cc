@@ -88,7 +88,8 @@ nlohmann::json LightingJson(const FrameLighting& l, const std::optional<glm::vec
     j["sphericalHarmonicsCoefficients"] = nullptr;
     j["sphericalHarmonicsAt"] = nullptr;
   } else {
-    const glm::vec3 point = at.value_or(0.5f * (l.volume.min + l.volume.max));
+    // The volume holds its edge beyond its box: the point it was taken at is the nearest inside.
+    const glm::vec3 point = glm::clamp(at.value_or(0.5f * (l.volume.min + l.volume.max)), l.volume.min, l.volume.max);
     const std::array<float, 27> c = RadianceCoefficients(l.volume.At(point));
     j["sphericalHarmonicsCoefficients"] = c;
     j["sphericalHarmonicsAt"] = {point.x, point.y, point.z};

@@ -149,6 +149,13 @@ TEST(LightingServerTest, ShCoefficientsAreTheVolumesRadianceCoefficientsAtThePoi
   EXPECT_NEAR(j["sphericalHarmonicsCoefficients"][0].get<double>(), 1.0 / glm::pi<double>(), 1e-6);
   EXPECT_NEAR(j["sphericalHarmonicsCoefficients"][7].get<double>(), 2.0 / (2.0 * glm::pi<double>() / 3.0), 1e-6);
   EXPECT_EQ(j["sphericalHarmonicsAt"][0], 0.0);
+  // Far outside the volume: the nearest probe's light, and the point it was taken at (issue 43:
+  // it echoed 1e30).
+  res = client.Get("/lighting?at=1e30,0.5,-7");
+  ASSERT_TRUE(res && res->status == 200);
+  j = nlohmann::json::parse(res->body);
+  EXPECT_NEAR(j["sphericalHarmonicsCoefficients"][0].get<double>(), 3.0 / glm::pi<double>(), 1e-6);
+  EXPECT_EQ(j["sphericalHarmonicsAt"], nlohmann::json({2.0, 0.5, 0.0}));
   res = client.Get("/lighting?at=1,2");
   ASSERT_TRUE(res);
   EXPECT_EQ(res->status, 400);

@@ -240,6 +240,9 @@ TEST(CliTest, EstimateWritesTheStableCsv) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   std::ifstream figures_in(figures);
   EXPECT_EQ(nlohmann::json::parse(figures_in).at("frames").get<int>(), 1);
+  // One frame, which moved the sun: no per-frame timing, said in words, not "nan ms" (issue 43).
+  EXPECT_EQ(run.err.find("nan"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("not timed"), std::string::npos) << run.err;
   EXPECT_EQ(ReadCsvFile(rec.dir / "est_bursts.csv").rows.size(), 1u);  // the per-burst table, no truth
   const CsvTable table = ReadCsvFile(out);
   EXPECT_EQ(table.header, (std::vector<std::string>{"frame", "time_utc", "sun_elevation_deg", "sun_azimuth_deg", "sun_r",
@@ -951,7 +954,15 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
        "--out and --plot both name " + dir + "/s.png"},
       {"relight-env " + kRecording + " --frame 0 --out " + dir + "/e.png", "--out: " + dir + "/e.png must end in .exr"},
       {"sunpos --time 2026-06-21T10:00:00Z --lat 50 --lon 10 --dut1 5", "--dut1: 5 s is not UT1 − UTC"},
-      {"sunpos --time 2026-06-21T10:00:00Z --lat 50 --lon 10 --delta-t 1e300", "--delta-t: 1e+300 s is outside [-1000, 20000]"},
+      {"sunpos --time 2026-06-21T10:00:00Z --lat 50 --lon 10 --delta-t 1e300", "--delta-t: '1e300' is not a finite number within ±1e30"},
+      {"sunpos --time 2026-06-21T10:00:00Z --lat 50 --lon 10 --delta-t 30000", "--delta-t: 30000 s is outside [-1000, 20000]"},
+      // NaN and inf on the command line (issue 43): CLI11's Range let NaN through, and a double
+      // beyond float's range overflowed the relit map to inf.
+      {"calibrate-scene " + kRecording + " --out " + dir + "/c.json --north-range nan", "--north-range: 'nan' is not a finite number"},
+      {"calibrate-scene " + kRecording + " --out " + dir + "/c.json --clock-range nan", "--clock-range: 'nan' is not a finite number"},
+      {"relight " + kRecording + " --like-frame 5 --e-sun 1e39,1e39,1e39 --out " + dir + "/r.mp4", "--e-sun: '1e39' is not a finite number"},
+      {"relight " + kRecording + " --like-frame 5 --e-sun 1e20,1,1 --out " + dir + "/r.mp4", "--e-sun: 1e+20 is not an irradiance (finite, in [0, 1e9])"},
+      {"sunpos --time 2026-06-21T10:00:00Z --lat nan --lon 10", "--lat: 'nan' is not a finite number"},
       {"sunpos --time 2023-03-01T23:59:60Z --lat 50 --lon 10", "no leap second ends that UTC day"},
       // Paths that are not what they must be (issue 21): bad input, exit 2, with the path.
       {"info " + (sandbox.dir() / "loop").string(), "loop: Too many levels of symbolic links"},

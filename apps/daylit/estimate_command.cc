@@ -1,3 +1,4 @@
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -83,9 +84,12 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   if (split) split->Finish(o.residuals, &report);
   if (shadows) CheckShadowsAndSay(scene, baked, caster, shadows->Finish(), &report);
   if (!o.figures.empty()) report.WriteFigures(o.figures);
-  Log().info("{} frames in {:.2f} s ({:.0f} fps end to end); estimation after decoding {:.2f} ms per frame (median), "
+  // Frames whose sun moved are timed as sun moves: a one-frame run has no per-frame figure.
+  const std::string per_frame = std::isfinite(run.median_estimate_ms) ? fmt::format("{:.2f} ms", run.median_estimate_ms)
+                                                                      : std::string("not timed (every frame moved the sun)");
+  Log().info("{} frames in {:.2f} s ({:.0f} fps end to end); estimation after decoding {} per frame (median), "
              "plus {} sun moves taking {:.0f} ms in all; wrote {} and {}",
-             n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9), run.median_estimate_ms,
+             n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9), per_frame,
              run.sun_moves_ms.size(), moves_ms, o.out, plot);
   if (run.undecodable > 0) Log().warn("{} frames could not be decoded", run.undecodable);
 }

@@ -1,5 +1,7 @@
 // daylit: consistent lighting for outdoor augmented reality. See README.md.
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <string>
@@ -14,6 +16,28 @@
 #include "base/log.h"
 #include "base/version.h"
 #include "scene/scene.h"
+
+namespace {
+
+// Every number an option takes as FLOAT must be finite and within float's range (the maps and the
+// GL are float): CLI11 reads "nan", "inf" and 1e39 as doubles, and its Range lets NaN through.
+void RefuseNonFiniteNumbers(CLI::App* app) {
+  const CLI::Validator finite(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (end == text.c_str()) return {};  // not a number: CLI11's own conversion says so
+        if (!std::isfinite(value) || std::fabs(value) > 1e30) return "'" + text + "' is not a finite number within ±1e30";
+        return {};
+      },
+      "");
+  for (CLI::Option* option : app->get_options()) {
+    if (option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite);
+  }
+  for (CLI::App* sub : app->get_subcommands({})) RefuseNonFiniteNumbers(sub);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   // libav's and OpenCV's own lines would come before daylit's one-line messages: libav's go to
@@ -45,6 +69,7 @@ int main(int argc, char** argv) {
   daylit::app::AddRelightCommand(app);
   daylit::app::AddLiveCommand(app);
   daylit::app::AddResultsCommand(app);
+  RefuseNonFiniteNumbers(&app);
   // The first word that is not an option must be a command: say so when it is not, rather than
   // that one is required.
   for (int i = 1; i < argc; ++i) {

@@ -55,7 +55,8 @@ struct RelightOptions {
 glm::dvec3 RgbOption(const std::vector<double>& v, const char* option) {
   if (v.size() != 3) ThrowInputError("{}: give R,G,B ({} values given)", option, v.size());
   for (const double x : v) {
-    if (!std::isfinite(x) || x < 0.0) ThrowInputError("{}: {} is not an irradiance (finite, ≥ 0)", option, x);
+    // 1e9: far beyond any sun in any camera's units, and its products stay finite in float.
+    if (!std::isfinite(x) || x < 0.0 || x > 1e9) ThrowInputError("{}: {} is not an irradiance (finite, in [0, 1e9])", option, x);
   }
   return {v[0], v[1], v[2]};
 }

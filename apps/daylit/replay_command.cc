@@ -207,8 +207,12 @@ void WriteReplayReport(const scene::Scene& scene, const pipeline::PipelineRun& r
   if (run.undecodable > 0 && live) Log().warn("{} frames could not be read from the camera", run.undecodable);
   report.Say(fmt::format("{}: {} frames in {:.1f} s, {:.1f} fps end to end (decode, estimate, relight, render, encode)",
                          scene.name, n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9)));
-  report.Say(fmt::format("  per frame (median): estimate {:.1f} ms, relight + render {:.1f} ms (encoding on its own thread)",
-                         run.median_estimate_ms, run.median_stage_ms));
+  // A frame whose sun moved (the first always) is timed as a sun move: a run of one frame, or of
+  // frames that each moved the sun, has no estimate timing to give.
+  const std::string estimate_ms = std::isfinite(run.median_estimate_ms) ? fmt::format("{:.1f} ms", run.median_estimate_ms)
+                                                                        : std::string("not timed (too few frames)");
+  report.Say(fmt::format("  per frame (median): estimate {}, relight + render {:.1f} ms (encoding on its own thread)",
+                         estimate_ms, run.median_stage_ms));
   if (run.undecodable > 0) report.Say(fmt::format("  {} frames could not be decoded (shown as the frame before)", run.undecodable));
   if (live) {
     std::vector<double> latency = run.latency_ms;
