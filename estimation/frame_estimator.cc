@@ -10,6 +10,7 @@
 
 #include "base/check.h"
 #include "base/error.h"
+#include "sky/atmosphere.h"
 
 namespace daylit::estimation {
 namespace {
@@ -18,8 +19,10 @@ glm::vec3 CapturePoint(const scene::Scene& scene) {
   return scene.envmap ? glm::vec3(scene.envmap->position) : glm::vec3(0.0f);
 }
 
-// 1/sin elevation, the sun taken at 1° or higher.
-double AirMass(const glm::vec3& sun_dir) { return 1.0 / std::max(static_cast<double>(sun_dir.z), 0.0175); }
+// Kasten and Young's relative air mass toward the (apparent) sun direction, sky/atmosphere.h.
+double AirMass(const glm::vec3& sun_dir) {
+  return sky::RelativeAirMass(glm::degrees(std::asin(std::clamp(static_cast<double>(sun_dir.z), -1.0, 1.0))));
+}
 
 }  // namespace
 

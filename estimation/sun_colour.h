@@ -12,7 +12,7 @@
 //   model's errors: an overcast burst's hundred weak suns are as wrong as one of them. An episode
 //   is worth its best frame, not the sum of its frames; its colour is their weighted mean.
 // - The atmosphere's transmittance carries a colour from one elevation to another only so far: a
-//   colour carried across an air mass Δm (1/sin elevation) is worth at most
+//   colour carried across an air mass Δm (Kasten and Young's, sky/atmosphere.h) is worth at most
 //   (frame_error / (error_per_air_mass · Δm))².
 #pragma once
 

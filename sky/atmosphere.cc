@@ -106,4 +106,9 @@ glm::dvec3 Atmosphere::Radiance(double view_mu, double sun_mu, double cos_gamma,
   return sum;
 }
 
+double RelativeAirMass(double apparent_elevation_deg) {
+  const double h = std::clamp(apparent_elevation_deg, 0.0, 90.0);
+  return 1.0 / (std::sin(glm::radians(h)) + 0.50572 * std::pow(h + 6.07995, -1.6364));
+}
+
 }  // namespace daylit::sky

@@ -67,4 +67,12 @@ class Atmosphere {
   std::vector<glm::dvec2> depth_;  // [height · kMus + mu]
 };
 
+// The relative optical air mass toward a sun at `apparent_elevation_deg` (refraction included, as
+// the sun is seen): the air along the path over the air toward the zenith, 1 at the zenith, about
+// 2 at 30°, 26 at 1° and 38 at the horizon (where 1/sin elevation is 57 at 1° and infinite at 0°).
+// Kasten and Young, "Revised optical air mass tables and approximation formula", Applied Optics 28
+// (1989) 4735-4738, their equation 3: within 0.5% of their tables down to a 1.6° elevation and
+// within 1.3% below. Elevations below the horizon are taken at it.
+double RelativeAirMass(double apparent_elevation_deg);
+
 }  // namespace daylit::sky
