@@ -7,6 +7,11 @@
 #include "capture/frame_times.h"
 
 namespace daylit::estimation {
+namespace {
+
+constexpr double kAirMassBin = 0.02;
+
+}  // namespace
 
 std::string SunColourOptions::Check() const {
   return FirstProblem({InOpenClosed("prior_weight", prior_weight, 0.0, 1e6), InOpenClosed("frame_error", frame_error, 0.0, 1.0),
@@ -15,48 +20,68 @@ std::string SunColourOptions::Check() const {
 }
 
 SunColourMemory::SunColourMemory(SunColourOptions options, const glm::dvec3& prior, double prior_air_mass)
-    : options_(options),
-      log_carried_(glm::log(prior / prior.y)),
-      carried_weight_(options.prior_weight),
-      carried_air_mass_(prior_air_mass) {}
+    : options_(options) {
+  Add(glm::log(prior / prior.y), options.prior_weight, prior_air_mass);
+}
 
-void SunColourMemory::StartEpisode(const UtcTime& utc, double air_mass) {
-  // The episode that ends joins what is carried, worth its best frame.
-  if (in_episode_ && episode_weight_sum_ > 0.0) {
-    const glm::dvec3 log_episode = episode_sum_ / episode_weight_sum_;
-    log_carried_ = (carried_weight_ * log_carried_ + episode_best_ * log_episode) / (carried_weight_ + episode_best_);
-    carried_weight_ += episode_best_;
+void SunColourMemory::Add(const glm::dvec3& log_colour, double weight, double air_mass) {
+  Measured& bin = measured_[std::lround(air_mass / kAirMassBin)];
+  bin.weight += weight;
+  bin.log_sum += weight * log_colour;
+  bin.air_mass_sum += weight * air_mass;
+}
+
+void SunColourMemory::EndEpisode() {
+  // The episode joins what is carried, worth its best frame, at its frames' mean air mass.
+  if (in_episode_ && episode_.weight > 0.0) {
+    Add(episode_.log_sum / episode_.weight, episode_best_, episode_.air_mass_sum / episode_.weight);
   }
-  in_episode_ = true;
-  episode_start_ = utc;
-  episode_sum_ = glm::dvec3(0.0);
-  episode_weight_sum_ = episode_best_ = 0.0;
-  // Carried to this air mass: worth at most what the transmittance gets right across it.
-  const double moved = std::abs(air_mass - carried_air_mass_) * options_.error_per_air_mass;
-  if (moved > 0.0) carried_weight_ = std::min(carried_weight_, std::pow(options_.frame_error / moved, 2.0));
-  carried_air_mass_ = air_mass;
+  episode_ = Measured{};
+  episode_best_ = 0.0;
 }
 
 SunColourMemory::Colour SunColourMemory::At(const UtcTime& utc, double air_mass) {
   if (!in_episode_ || !(utc.SecondsSince(last_) < capture::kBurstGapS) ||
       !(utc.SecondsSince(episode_start_) < options_.episode_s)) {
-    StartEpisode(utc, air_mass);
+    EndEpisode();
+    in_episode_ = true;
+    episode_start_ = utc;
   }
   last_ = utc;
+  air_mass_ = air_mass;
+  // Each measurement (a bin, and this episode worth its best frame) weighed by what it is worth
+  // here, 1 / (1/w + k Δm²) with k = (error_per_air_mass / frame_error)²; the mean's variance (in
+  // units of frame_error²) is Σ a²/w over the measurements' shares a, plus k times the squared
+  // distance of their mean air mass, the transmittance's error that all of them share.
+  const double k = std::pow(options_.error_per_air_mass / options_.frame_error, 2.0);
+  double worth_sum = 0.0, share_sq_over_w = 0.0, air_mass_mean = 0.0;
+  glm::dvec3 log_mean(0.0);
+  const auto take = [&](double weight, const glm::dvec3& log_colour, double at) {
+    const double worth = 1.0 / (1.0 / weight + k * (air_mass - at) * (air_mass - at));
+    worth_sum += worth;
+    share_sq_over_w += worth * worth / weight;
+    air_mass_mean += worth * at;
+    log_mean += worth * log_colour;
+  };
+  for (const auto& [bin, m] : measured_) {
+    if (m.weight > 0.0) take(m.weight, m.log_sum / m.weight, m.air_mass_sum / m.weight);
+  }
+  if (episode_.weight > 0.0) take(episode_best_, episode_.log_sum / episode_.weight, episode_.air_mass_sum / episode_.weight);
   Colour out;
-  const double episode = episode_weight_sum_ > 0.0 ? episode_best_ : 0.0;
-  out.weight = carried_weight_ + episode;
-  if (out.weight <= 0.0) return out;
-  const glm::dvec3 log_episode = episode > 0.0 ? episode_sum_ / episode_weight_sum_ : glm::dvec3(0.0);
-  out.above = glm::exp((carried_weight_ * log_carried_ + episode * log_episode) / out.weight);
+  if (!(worth_sum > 0.0)) return out;
+  air_mass_mean /= worth_sum;
+  const double variance = share_sq_over_w / (worth_sum * worth_sum) + k * (air_mass - air_mass_mean) * (air_mass - air_mass_mean);
+  out.weight = 1.0 / variance;
+  out.above = glm::exp(log_mean / worth_sum);
   return out;
 }
 
 void SunColourMemory::Measure(const UtcTime& utc, const glm::dvec3& above, double weight) {
   if (!(weight > 0.0) || !(glm::min(above.x, glm::min(above.y, above.z)) > 0.0)) return;
   last_ = utc;
-  episode_sum_ += weight * glm::log(above / above.y);
-  episode_weight_sum_ += weight;
+  episode_.weight += weight;
+  episode_.log_sum += weight * glm::log(above / above.y);
+  episode_.air_mass_sum += weight * air_mass_;
   episode_best_ = std::max(episode_best_, weight);
 }
 

@@ -11,11 +11,16 @@
 // - The frames of one episode (frames less than 2 s apart, at most a minute of them) share their
 //   model's errors: an overcast burst's hundred weak suns are as wrong as one of them. An episode
 //   is worth its best frame, not the sum of its frames; its colour is their weighted mean.
-// - The atmosphere's transmittance carries a colour from one elevation to another only so far: a
-//   colour carried across an air mass Δm (Kasten and Young's, sky/atmosphere.h) is worth at most
-//   (frame_error / (error_per_air_mass · Δm))².
+// - The atmosphere's transmittance carries a colour from one elevation to another only so far. A
+//   colour measured at air mass m_i (Kasten and Young's, sky/atmosphere.h) with weight w_i has the
+//   error variance frame_error²/w_i; carried to air mass m it gains the transmittance's error,
+//   (error_per_air_mass · (m − m_i))², which is the same for every measurement (one atmosphere
+//   model). The colour at m is the measurements' mean weighted by what each is worth at m, and it
+//   is worth frame_error² over the variance of that mean, the common term counted once: a colour
+//   drifts no further from where it was measured by being carried a minute at a time.
 #pragma once
 
+#include <map>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -51,19 +56,27 @@ class SunColourMemory {
   };
   // What is known for a frame at `utc` with the sun at `air_mass`.
   Colour At(const UtcTime& utc, double air_mass);
-  // A frame's own measurement: its E_sun above the atmosphere (RGB, > 0) and its weight.
+  // A frame's own measurement: its E_sun above the atmosphere (RGB, > 0) and its weight, at the
+  // air mass of the At() before it.
   void Measure(const UtcTime& utc, const glm::dvec3& above, double weight);
 
  private:
-  void StartEpisode(const UtcTime& utc, double air_mass);
+  // What was measured near one air mass (bins 0.02 wide: 0.001 of colour at the default error per
+  // air mass): Σ w, Σ w · log colour, Σ w · air mass.
+  struct Measured {
+    double weight = 0.0;
+    glm::dvec3 log_sum{0.0};
+    double air_mass_sum = 0.0;
+  };
+  void Add(const glm::dvec3& log_colour, double weight, double air_mass);
+  void EndEpisode();
   SunColourOptions options_;
-  glm::dvec3 log_carried_{0.0};  // earlier episodes'
-  double carried_weight_ = 0.0;
-  double carried_air_mass_ = 1.0;
+  std::map<long, Measured> measured_;  // earlier episodes' and the prior, by air mass bin
   bool in_episode_ = false;
   UtcTime episode_start_, last_;
-  glm::dvec3 episode_sum_{0.0};  // Σ w · log colour
-  double episode_weight_sum_ = 0.0, episode_best_ = 0.0;
+  double air_mass_ = 1.0;                        // the frame at hand's (the last At's)
+  Measured episode_;                             // this episode's frames
+  double episode_best_ = 0.0;
 };
 
 }  // namespace daylit::estimation

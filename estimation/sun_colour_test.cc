@@ -35,13 +35,48 @@ TEST(SunColourTest, AColourCarriedAcrossAirMassIsWorthWhatTheAtmosphereGetsRight
     memory.At(At(i * 0.1), 1.8);
     memory.Measure(At(i * 0.1), glm::dvec3(1.3, 1.0, 0.7), 1.0);
   }
-  // Ten hours later (a new episode) at air mass 1.34 (48°): worth at most (0.02 / (0.05 · 0.46))².
+  // Ten hours later (a new episode) at air mass 1.34 (48°): the prior and the fifty frames' episode
+  // (worth its best frame) were measured at 1.8, so their error gains the transmittance's across
+  // 0.46: worth 1 / (1/1.25 + (0.05 · 0.46 / 0.02)²).
+  const auto worth = [](double weight, double moved) { return 1.0 / (1.0 / weight + std::pow(0.05 * moved / 0.02, 2.0)); };
   const SunColourMemory::Colour near = memory.At(At(36000.0), 1.34);
-  EXPECT_NEAR(near.weight, std::pow(0.02 / (0.05 * 0.46), 2.0), 1e-9);
-  // And then at air mass 5.2 (11°): far less.
+  EXPECT_NEAR(near.weight, worth(1.25, 0.46), 1e-9);
+  // And then at air mass 5.2 (11°): far less, carried from 1.8, where it was measured.
   const SunColourMemory::Colour far = memory.At(At(72000.0), 5.2);
-  EXPECT_NEAR(far.weight, std::pow(0.02 / (0.05 * (5.2 - 1.34)), 2.0), 1e-9);
+  EXPECT_NEAR(far.weight, worth(1.25, 5.2 - 1.8), 1e-9);
   EXPECT_NEAR(far.above.z, 0.7, 1e-9);  // the colour itself is carried unchanged
+  // Back at 1.8 it is worth what it was.
+  EXPECT_NEAR(memory.At(At(80000.0), 1.8).weight, 1.25, 1e-9);
+}
+
+TEST(SunColourTest, AColourCarriedAMinuteAtATimeIsWorthWhatItsWholeDriftAllows) {
+  // A clear episode at air mass 1.2, then three hours of frames every second under cloud that
+  // measure nothing, the sun sinking to air mass 4: a new episode every minute, each a small step
+  // of air mass. Carried from 1.2 to 4, the colour is worth what the transmittance gets right
+  // across 2.8, not what it gets right across one minute's step.
+  SunColourOptions options;
+  SunColourMemory memory(options);
+  memory.At(At(0.0), 1.2);
+  memory.Measure(At(0.0), glm::dvec3(1.3, 1.0, 0.7), 1.0);
+  SunColourMemory::Colour last;
+  const int seconds = 3 * 3600;
+  for (int s = 1; s <= seconds; ++s) last = memory.At(At(s), 1.2 + 2.8 * s / seconds);
+  EXPECT_NEAR(last.weight, 1.0 / (1.0 + std::pow(0.05 * 2.8 / 0.02, 2.0)), 1e-6);
+  EXPECT_NEAR(last.above.x, 1.3, 1e-9);
+}
+
+TEST(SunColourTest, MeasurementsNearTheSunAtHandCountMoreThanFarOnes) {
+  // A colour measured at air mass 1.2 and another at 4, each worth one frame: at air mass 4 the
+  // second dominates, and the two together are worth more than either alone.
+  SunColourMemory memory;
+  memory.At(At(0.0), 1.2);
+  memory.Measure(At(0.0), glm::dvec3(1.3, 1.0, 0.7), 1.0);
+  memory.At(At(3600.0), 4.0);
+  memory.Measure(At(3600.0), glm::dvec3(1.1, 1.0, 0.8), 1.0);
+  const SunColourMemory::Colour c = memory.At(At(7200.0), 4.0);
+  EXPECT_NEAR(c.above.z, 0.8, 0.01);
+  EXPECT_GT(c.weight, 1.0);
+  EXPECT_LT(c.weight, 1.1);
 }
 
 TEST(SunColourTest, NothingKnownWithoutAPriorUntilAFrameIsMeasured) {
