@@ -88,8 +88,12 @@ FrameLight FrameEstimator::Estimate(const capture::Frame& frame, const scene::Tr
   out.fit = FitWithSunColour(out.samples, sun.dir_in_scene, frame.utc);
   const FilteredLight filtered =
       filter_.Update(t_s, out.fit.IsUsable() ? std::optional<SunSky>(out.fit.light) : std::nullopt, out.fit.confidence);
-  if (out.fit.IsUsable()) overcast_share_ = out.fit.overcast_share;
+  if (out.fit.IsUsable()) {
+    overcast_share_ = out.fit.overcast_share;
+    interval_ = IntervalOfFit(options_.interval, options_.fit, out.samples, out.fit, bake_.camera.surface);
+  }
   out.overcast_share = overcast_share_;
+  out.row.interval = interval_;
   out.row.light = filtered.light;
   out.row.confidence = filtered.confidence;
   out.row.samples = static_cast<int>(out.samples.size());
@@ -106,6 +110,7 @@ FrameLight FrameEstimator::Hold(const capture::Frame& frame, const scene::Tracke
   const FilteredLight held = filter_.Update(SecondsSinceFirst(frame.utc), std::nullopt, 0.0);
   out.row.light = held.light;
   out.row.confidence = held.confidence;
+  out.row.interval = interval_;
   out.overcast_share = overcast_share_;
   out.fit.message = "the frame could not be read";
   return out;
@@ -150,19 +155,24 @@ FrameFit FitDecodedFrame(const scene::Scene& scene, const bake::SceneBake& bake,
 std::string EstimatesCsv(const std::vector<FrameEstimate>& frames) {
   fmt::memory_buffer out;
   fmt::format_to(std::back_inserter(out), "frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,"
-                                          "sky_g,sky_b,confidence,samples\n");
+                                          "sky_g,sky_b,confidence,samples,sun_r_lo,sun_r_hi,sun_g_lo,sun_g_hi,sun_b_lo,"
+                                          "sun_b_hi,sky_r_lo,sky_r_hi,sky_g_lo,sky_g_hi,sky_b_lo,sky_b_hi\n");
   for (const FrameEstimate& f : frames) {
-    fmt::format_to(std::back_inserter(out), "{},{},{:.4f},{:.4f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{}\n",
+    fmt::format_to(std::back_inserter(out), "{},{},{:.4f},{:.4f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{}",
                    f.frame, FormatUtcTime(f.time_utc), f.sun_elevation_deg, f.sun_azimuth_deg, f.light.sun_rgb.x,
                    f.light.sun_rgb.y, f.light.sun_rgb.z, f.light.sky_rgb.x, f.light.sky_rgb.y, f.light.sky_rgb.z,
                    f.confidence, f.samples);
+    const IntervalBounds bounds = BoundsOf(f.light, f.interval);
+    for (const glm::dvec2& b : bounds.sun) fmt::format_to(std::back_inserter(out), ",{:.6g},{:.6g}", b.x, b.y);
+    for (const glm::dvec2& b : bounds.sky) fmt::format_to(std::back_inserter(out), ",{:.6g},{:.6g}", b.x, b.y);
+    fmt::format_to(std::back_inserter(out), "\n");
   }
   return fmt::to_string(out);
 }
 
 std::string FrameEstimatorOptions::Check() const {
   return FirstProblem({Nested("sampler", sampler.Check()), Nested("fit", fit.Check()), Nested("filter", filter.Check()),
-                       Nested("sun_colour", sun_colour.Check())});
+                       Nested("sun_colour", sun_colour.Check()), Nested("interval", interval.Check())});
 }
 
 }  // namespace daylit::estimation

@@ -9,6 +9,7 @@
 
 #include "bake/bake.h"
 #include "capture/frame_source.h"
+#include "estimation/light_interval.h"
 #include "estimation/sampler.h"
 #include "estimation/sun_colour.h"
 #include "estimation/sun_sky_fit.h"
@@ -24,6 +25,7 @@ struct FrameEstimatorOptions {
   SunSkyFitOptions fit;
   TemporalFilterOptions filter;
   SunColourOptions sun_colour;
+  LightIntervalOptions interval;
   // Empty when every field is in range, else the first problem, naming the field.
   std::string Check() const;
 };
@@ -36,6 +38,9 @@ struct FrameEstimate {
   double sun_azimuth_deg = 0.0;    // east of north
   SunSky light;                    // filtered E_sun, E_sky (radiance units, exposure divided out)
   double confidence = 0.0;
+  // The 90% interval of the frame's fit (estimation/light_interval.h), relative, taken for the
+  // filtered light; a frame without a usable fit holds the last one's.
+  LightInterval interval;
   int samples = 0;
   // The fit's strata (not in the CSV): samples the sun reaches well, samples in shadow, and
   // whether the sun was up. Sun up with no sunlit sample: E_sun not observed (the estimate holds).
@@ -84,6 +89,7 @@ class FrameEstimator {
   capture::Linearizer linearizer_;
   std::optional<UtcTime> first_utc_;
   double overcast_share_ = 0.0;
+  LightInterval interval_;  // the last usable fit's
   SunColourMemory sun_colour_;
 };
 

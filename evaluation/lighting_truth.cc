@@ -120,7 +120,7 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
     r.burst = b;
     r.first_frame = frames[b.begin].frame, r.last_frame = frames[b.end - 1].frame;
     r.sun_elevation_deg = frames[b.begin].sun_elevation_deg;
-    std::array<std::vector<double>, 3> sun, sky, sun_error, sky_error;
+    std::array<std::vector<double>, 3> sun, sky, sun_error, sky_error, sun_half, sky_half;
     std::vector<double> confidence, sunlit, shadowed;
     r.min_confidence = 1.0;
     for (size_t i = b.begin; i < b.end; ++i) {
@@ -131,8 +131,12 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
       r.frames_without_sunlit += f.sun_up && f.sunlit_samples == 0 ? 1 : 0;
       r.frames_without_shadowed += f.shadowed_samples == 0 ? 1 : 0;
       r.min_confidence = std::min(r.min_confidence, f.confidence);
+      r.frames_sun_not_observed += f.interval.known && !f.interval.sun_observed ? 1 : 0;
       for (size_t k = 0; k < 3; ++k) {
         sun[k].push_back(f.light.sun_rgb[static_cast<int>(k)]), sky[k].push_back(f.light.sky_rgb[static_cast<int>(k)]);
+        if (f.interval.known) {
+          sun_half[k].push_back(f.interval.sun[static_cast<int>(k)]), sky_half[k].push_back(f.interval.sky[static_cast<int>(k)]);
+        }
         if (truth == nullptr) continue;
         const estimation::SunSky& t = truth->truth[i];
         const int c = static_cast<int>(k);
@@ -146,7 +150,16 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
     for (int c = 0; c < 3; ++c) {
       const size_t k = static_cast<size_t>(c);
       r.sun[c] = Median(sun[k]), r.sky[c] = Median(sky[k]);
+      if (!sun_half[k].empty()) r.sun_half_width[c] = Median(sun_half[k]), r.sky_half_width[c] = Median(sky_half[k]);
       if (r.has_truth) r.sun_error[c] = Median(sun_error[k]), r.sky_error[c] = Median(sky_error[k]);
+    }
+    if (r.has_truth) {
+      r.interval_covers = true;
+      for (int c = 0; c < 3; ++c) {
+        // A NaN error (no truth in the burst) or width (no fit) covers nothing.
+        if (!std::isnan(r.sun_error[c]) && !(r.sun_error[c] <= r.sun_half_width[c])) r.interval_covers = false;
+        if (!std::isnan(r.sky_error[c]) && !(r.sky_error[c] <= r.sky_half_width[c])) r.interval_covers = false;
+      }
     }
     out.push_back(r);
   }
@@ -156,17 +169,25 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
 std::string BurstsCsv(const std::vector<BurstLighting>& bursts) {
   const bool truth = !bursts.empty() && bursts[0].has_truth;
   std::string csv = "burst,first_frame,last_frame,frames,sun_elevation_deg,sun_r,sun_g,sun_b,sky_r,sky_g,sky_b,confidence,"
-                    "min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,frames_without_shadowed";
-  csv += truth ? ",sun_error_r,sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b\n" : "\n";
+                    "min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,frames_without_shadowed,"
+                    "sun_r_lo,sun_r_hi,sun_g_lo,sun_g_hi,sun_b_lo,sun_b_hi,sky_r_lo,sky_r_hi,sky_g_lo,sky_g_hi,sky_b_lo,"
+                    "sky_b_hi,frames_sun_not_observed";
+  csv += truth ? ",sun_error_r,sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b,interval_covers\n" : "\n";
   for (const BurstLighting& b : bursts) {
     csv += fmt::format("{},{},{},{},{:.3f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{:.4f}", b.burst.index,
                        b.first_frame, b.last_frame, b.burst.end - b.burst.begin, b.sun_elevation_deg, b.sun.x, b.sun.y,
                        b.sun.z, b.sky.x, b.sky.y, b.sky.z, b.confidence, b.min_confidence);
     csv += fmt::format(",{},{},{},{}", b.sunlit_samples, b.shadowed_samples, b.frames_without_sunlit,
                        b.frames_without_shadowed);
+    estimation::LightInterval interval;
+    interval.sun = b.sun_half_width, interval.sky = b.sky_half_width;
+    const estimation::IntervalBounds bounds = estimation::BoundsOf({b.sun, b.sky}, interval);
+    for (const glm::dvec2& x : bounds.sun) csv += fmt::format(",{:.6g},{:.6g}", x.x, x.y);
+    for (const glm::dvec2& x : bounds.sky) csv += fmt::format(",{:.6g},{:.6g}", x.x, x.y);
+    csv += fmt::format(",{}", b.frames_sun_not_observed);
     if (truth) {
-      csv += fmt::format(",{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f}", b.sun_error.x, b.sun_error.y, b.sun_error.z,
-                         b.sky_error.x, b.sky_error.y, b.sky_error.z);
+      csv += fmt::format(",{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{}", b.sun_error.x, b.sun_error.y, b.sun_error.z,
+                         b.sky_error.x, b.sky_error.y, b.sky_error.z, b.interval_covers ? 1 : 0);
     }
     csv += "\n";
   }
@@ -243,6 +264,39 @@ void ReportBursts(const std::vector<BurstLighting>& bursts, const std::filesyste
     for (int c = 0; truth && c < 3; ++c) {
       report->Figure(key + "sun_error/" + std::string(1, "rgb"[c]), b.sun_error[c]);
       report->Figure(key + "sky_error/" + std::string(1, "rgb"[c]), b.sky_error[c]);
+    }
+  }
+  // The 90% intervals, from the frames alone (estimation/light_interval.h), and with truth whether
+  // each burst's errors lie within them.
+  report->Say(fmt::format("  90% interval per burst (relative half-width, R, G, B; from the frames, not the truth){}:",
+                          truth ? ", and whether it holds the error" : ""));
+  std::vector<double> sun_widths, sky_widths;
+  int covered = 0, with_interval = 0;
+  for (const BurstLighting& b : bursts) {
+    if (std::isnan(b.sky_half_width.x)) continue;
+    ++with_interval;
+    const std::string sun = b.frames_sun_not_observed * 2 > static_cast<int>(b.burst.end - b.burst.begin)
+                                ? std::string("not observed")
+                                : fmt::format("±{:.1f}% ±{:.1f}% ±{:.1f}%", 100 * b.sun_half_width.x,
+                                              100 * b.sun_half_width.y, 100 * b.sun_half_width.z);
+    report->Say(fmt::format("  {:>5}  E_sun {:<24} E_sky ±{:.1f}% ±{:.1f}% ±{:.1f}%{}", b.burst.index, sun,
+                            100 * b.sky_half_width.x, 100 * b.sky_half_width.y, 100 * b.sky_half_width.z,
+                            truth ? (b.interval_covers ? "  holds" : "  MISSES") : ""));
+    const std::string key = fmt::format("lighting/burst/{}/", b.burst.index);
+    for (int c = 0; c < 3; ++c) {
+      report->Figure(key + "sun_half_width/" + std::string(1, "rgb"[c]), b.sun_half_width[c]);
+      report->Figure(key + "sky_half_width/" + std::string(1, "rgb"[c]), b.sky_half_width[c]);
+    }
+    sun_widths.push_back(glm::compAdd(b.sun_half_width) / 3.0), sky_widths.push_back(glm::compAdd(b.sky_half_width) / 3.0);
+    covered += b.interval_covers ? 1 : 0;
+  }
+  if (with_interval > 0) {
+    report->Figure("lighting/interval/sun_half_width", Median(sun_widths));
+    report->Figure("lighting/interval/sky_half_width", Median(sky_widths));
+    if (truth) {
+      report->Say(fmt::format("  the interval holds all six errors in {} of {} bursts", covered, with_interval));
+      report->Figure("lighting/interval/covered_bursts", covered);
+      report->Figure("lighting/interval/bursts", with_interval);
     }
   }
   for (const BurstLighting& b : bursts) {

@@ -68,13 +68,21 @@ struct BurstLighting {
   // E_sky rests on the sunlit samples alone). Both lower the confidence.
   int sunlit_samples = 0, shadowed_samples = 0;
   int frames_without_sunlit = 0, frames_without_shadowed = 0;
+  // The 90% interval (estimation/light_interval.h): the median over its decoded frames of their
+  // relative half-widths, per channel, and the frames whose sun was not observed (too weak a part
+  // of the sunlit samples' light for a width to mean anything).
+  glm::dvec3 sun_half_width{NAN}, sky_half_width{NAN};
+  int frames_sun_not_observed = 0;
   bool has_truth = false;
   glm::dvec3 sun_error{NAN}, sky_error{NAN};
+  // With truth: each of the six errors within its half-width (E_sun's only where observed).
+  bool interval_covers = false;
 };
 std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEstimate>& frames, const TruthComparison* truth);
 // bursts.csv: burst,first_frame,last_frame,frames,sun_elevation_deg,sun_r,sun_g,sun_b,sky_r,sky_g,
 // sky_b,confidence,min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,
-// frames_without_shadowed[,sun_error_r,...,sky_error_b with truth].
+// frames_without_shadowed,sun_r_lo,sun_r_hi,...,sky_b_lo,sky_b_hi (the 90% interval around the
+// burst's medians),frames_sun_not_observed[,sun_error_r,...,sky_error_b,interval_covers with truth].
 std::string BurstsCsv(const std::vector<BurstLighting>& bursts);
 
 // Where the bursts' table goes beside the estimates' CSV `csv`: bursts.csv beside estimates.csv,

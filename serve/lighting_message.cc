@@ -84,6 +84,14 @@ nlohmann::json LightingJson(const FrameLighting& l, const std::optional<glm::vec
       {"confidence", r.confidence},
       {"hasEstimate", r.HasEstimate()},
   };
+  // The 90% intervals of E_sun and E_sky (estimation/light_interval.h), around the values above.
+  const estimation::IntervalBounds bounds = estimation::BoundsOf(r.light, r.interval);
+  const auto interval = [](const std::array<glm::dvec2, 3>& b) {
+    return nlohmann::json{{"lo", Xyz({b[0].x, b[1].x, b[2].x})}, {"hi", Xyz({b[0].y, b[1].y, b[2].y})}};
+  };
+  j["primaryLightIntensityInterval90"] = interval(bounds.sun);
+  j["skyIrradianceInterval90"] = interval(bounds.sky);
+  j["primaryLightObserved"] = r.interval.sun_observed;
   if (l.volume.empty()) {
     j["sphericalHarmonicsCoefficients"] = nullptr;
     j["sphericalHarmonicsAt"] = nullptr;

@@ -36,6 +36,9 @@ std::shared_ptr<FrameLighting> Frame(int index) {
   l->row.light.sun_rgb = glm::dvec3(80.0 + index, 60.0, 40.0);
   l->row.light.sky_rgb = glm::dvec3(10.0, 11.0, 12.0 + index);
   l->row.confidence = 0.75;
+  l->row.interval.known = l->row.interval.sun_observed = true;
+  l->row.interval.sun = glm::dvec3(0.05);
+  l->row.interval.sky = glm::dvec3(0.1);
   l->row.sun_up = true;
   l->sun_scene = glm::normalize(glm::vec3(0.3f, -0.4f, 0.8f));
   l->sun_camera = glm::normalize(glm::vec3(0.1f, -0.9f, 0.2f));
@@ -113,6 +116,9 @@ TEST(LightingServerTest, LightingIs503BeforeTheFirstFrameThenTheLatestWithWebXrN
   EXPECT_EQ(j["frame"], 7);
   EXPECT_DOUBLE_EQ(j["primaryLightIntensity"]["x"].get<double>(), 87.0);
   EXPECT_DOUBLE_EQ(j["skyIrradiance"]["z"].get<double>(), 19.0);
+  EXPECT_DOUBLE_EQ(j["primaryLightIntensityInterval90"]["hi"]["x"].get<double>(), 87.0 * 1.05);
+  EXPECT_DOUBLE_EQ(j["skyIrradianceInterval90"]["lo"]["z"].get<double>(), 19.0 * 0.9);
+  EXPECT_TRUE(j["primaryLightObserved"].get<bool>());
   const glm::vec3 sun = Frame(0)->sun_scene;
   EXPECT_NEAR(j["primaryLightDirection"]["y"].get<double>(), sun.y, 1e-6);
   EXPECT_TRUE(j["sphericalHarmonicsCoefficients"].is_null());  // no volume

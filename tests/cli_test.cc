@@ -246,10 +246,17 @@ TEST(CliTest, EstimateWritesTheStableCsv) {
   EXPECT_EQ(ReadCsvFile(rec.dir / "est_bursts.csv").rows.size(), 1u);  // the per-burst table, no truth
   const CsvTable table = ReadCsvFile(out);
   EXPECT_EQ(table.header, (std::vector<std::string>{"frame", "time_utc", "sun_elevation_deg", "sun_azimuth_deg", "sun_r",
-                                                     "sun_g", "sun_b", "sky_r", "sky_g", "sky_b", "confidence", "samples"}));
+                                                     "sun_g", "sun_b", "sky_r", "sky_g", "sky_b", "confidence", "samples",
+                                                     "sun_r_lo", "sun_r_hi", "sun_g_lo", "sun_g_hi", "sun_b_lo", "sun_b_hi",
+                                                     "sky_r_lo", "sky_r_hi", "sky_g_lo", "sky_g_hi", "sky_b_lo", "sky_b_hi"}));
   ASSERT_EQ(table.rows.size(), 1u);
   const double linear = capture::CameraResponse{}.ToLinear(120.0 / 255.0);
-  EXPECT_NEAR(ParseFiniteDouble(table.rows[0][7], "sky_r"), M_PI * linear / 0.4, 0.01 * M_PI * linear / 0.4);
+  const double sky = ParseFiniteDouble(table.rows[0][7], "sky_r");
+  EXPECT_NEAR(sky, M_PI * linear / 0.4, 0.01 * M_PI * linear / 0.4);
+  // The 90% interval: one surface, all of it sky-lit, agrees with itself, so E_sky's error is the
+  // least model error, 2%: ±1.645 · 2%.
+  EXPECT_NEAR(ParseFiniteDouble(table.rows[0][18], "sky_r_lo"), sky * (1.0 - 1.645 * 0.02), 1e-4 * sky);
+  EXPECT_NEAR(ParseFiniteDouble(table.rows[0][19], "sky_r_hi"), sky * (1.0 + 1.645 * 0.02), 1e-4 * sky);
   EXPECT_EQ(ParseFiniteDouble(table.rows[0][4], "sun_r"), 0.0);
   EXPECT_LT(ParseFiniteDouble(table.rows[0][2], "elevation"), 0.0);  // midnight at (0°, 0°)
   EXPECT_TRUE(fs::is_regular_file(rec.dir / "est.png"));
@@ -561,6 +568,10 @@ TEST(CliTest, ReplayWritesTheAugmentedVideoAndItsReport) {
   ASSERT_EQ(bursts.rows.size(), 1u);
   EXPECT_EQ(bursts.rows[0][static_cast<size_t>(bursts.RequireColumn("frames"))], "60");
   EXPECT_LT(std::stod(bursts.rows[0][static_cast<size_t>(bursts.RequireColumn("sky_error_g"))]), 0.10);
+  // Its 90% interval, made from the frames alone, holds the errors (estimation/light_interval.h).
+  EXPECT_EQ(bursts.rows[0][static_cast<size_t>(bursts.RequireColumn("interval_covers"))], "1");
+  EXPECT_LT(std::stod(bursts.rows[0][static_cast<size_t>(bursts.RequireColumn("sky_g_lo"))]),
+            std::stod(bursts.rows[0][static_cast<size_t>(bursts.RequireColumn("sky_g"))]));
   EXPECT_NE(run.out.find("per burst"), std::string::npos) << run.out;
   // The report's figures for scripts (docs/results.md): the run and the composite's truth frames.
   std::ifstream figures_in(dir / "figures.json");

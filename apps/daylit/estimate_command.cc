@@ -100,8 +100,9 @@ void AddEstimateCommand(CLI::App& app) {
   auto options = std::make_shared<EstimateCommandOptions>();
   CLI::App* cmd = app.add_subcommand("estimate", "Sun and sky RGB irradiance for every frame (headless, no GL)");
   cmd->footer("Bakes first when the cache is missing or stale. Writes the CSV (frame,time_utc,sun_elevation_deg,\n"
-              "sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,sky_g,sky_b,confidence,samples) and a plot; with ground\n"
-              "truth, prints the median errors.");
+              "sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,sky_g,sky_b,confidence,samples, then each value's 90%\n"
+              "interval: sun_r_lo,sun_r_hi,...,sky_b_lo,sky_b_hi) and a plot; with ground truth, prints the median\n"
+              "errors and whether the intervals hold them.");
   cmd->add_option("recording", options->recording, "Recording folder or its scene.json")->required();
   cmd->add_option("--cache", options->cache, "Bake cache folder (as for daylit bake)");
   cmd->add_option("--out", options->out, "Estimates CSV (default estimates.csv)");

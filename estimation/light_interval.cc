@@ -1,0 +1,118 @@
+#include "estimation/light_interval.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtx/component_wise.hpp>
+
+#include "base/options_check.h"
+
+namespace daylit::estimation {
+namespace {
+
+// One surface's samples in one stratum: their relative residuals, clipped, summed.
+struct SurfaceResiduals {
+  glm::dvec3 sum{0.0};
+  double n = 0.0;
+};
+
+// One stratum's model error per channel (the RMS of its surfaces' mean relative residuals, K/(K − 1)
+// in variance) and how many surfaces it had.
+struct StratumError {
+  glm::dvec3 error{0.0};
+  int surfaces = 0;
+};
+
+StratumError ErrorOfStratum(const std::vector<SurfaceResiduals>& surfaces, double floor) {
+  StratumError out;
+  glm::dvec3 sum_sq(0.0);
+  double n = 0.0;
+  for (const SurfaceResiduals& r : surfaces) {
+    if (r.n < 3.0) continue;
+    ++out.surfaces;
+    const glm::dvec3 bias = r.sum / r.n;
+    sum_sq += r.n * bias * bias;
+    n += r.n;
+  }
+  const double k = out.surfaces;
+  const glm::dvec3 variance = out.surfaces >= 2 ? sum_sq / n * (k / (k - 1.0)) : glm::dvec3(0.0);
+  out.error = glm::max(glm::sqrt(variance), glm::dvec3(floor));
+  return out;
+}
+
+}  // namespace
+
+std::string LightIntervalOptions::Check() const {
+  return FirstProblem({InOpenClosed("floor", floor, 0.0, 1.0), InOpenClosed("z", z, 0.0, 10.0),
+                       InOpenClosed("max_half_width", max_half_width, 0.0, 1e6)});
+}
+
+LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
+                            const std::vector<Sample>& samples, const SunSkyFitSummary& fit,
+                            const std::vector<uint32_t>& surface_of_pixel) {
+  LightInterval out;
+  if (!fit.IsUsable()) return out;
+  out.known = true;
+  const LightParts all = SplitLight(fit.light, fit.overcast_share);
+  const LightParts sun_only{all.sun, glm::vec3(0.0f), glm::vec3(0.0f)}, sky_only{glm::vec3(0.0f), all.clear, all.overcast};
+  // Relative residuals by stratum and surface, and each stratum's share of its light from the term
+  // it measures (a mean of shares, as the fit's SplitShares).
+  std::vector<SurfaceResiduals> lit, shadowed;  // by surface
+  glm::dvec3 sun_share(0.0), sky_share(0.0);
+  double lit_n = 0.0, shadowed_n = 0.0;
+  // Clipped where the fit stops counting a sample as an inlier (3 Cauchy scales): a walker or a
+  // misregistered edge is the fit's outlier, not a surface's bias.
+  const float clip = static_cast<float>(3.0 * fit_options.cauchy_scale);
+  for (const Sample& s : samples) {
+    const bool is_lit = s.sunlit && glm::compMin(s.sun) > fit_options.sunlit_threshold;
+    if (!is_lit && s.sunlit) continue;  // grazing sun: neither stratum
+    const glm::vec3 sun = PredictedRadiance(s, sun_only);
+    const glm::vec3 predicted = sun + PredictedRadiance(s, sky_only);
+    if (!(glm::compMin(predicted) > 0.0f)) continue;
+    const uint32_t surface = s.pixel < surface_of_pixel.size() ? surface_of_pixel[s.pixel] : 0;
+    std::vector<SurfaceResiduals>& stratum = is_lit ? lit : shadowed;
+    if (surface >= stratum.size()) {
+      if (surface > 1u << 16) continue;  // no surface (the sky): not a sample of the model
+      stratum.resize(surface + 1);
+    }
+    SurfaceResiduals& r = stratum[surface];
+    r.sum += glm::dvec3(glm::clamp(s.radiance / predicted - 1.0f, -clip, clip));
+    r.n += 1.0;
+    if (is_lit) {
+      sun_share += glm::dvec3(sun / predicted), lit_n += 1.0;
+    } else {
+      sky_share += glm::dvec3(1.0f - sun / predicted), shadowed_n += 1.0;
+    }
+  }
+  const StratumError lit_error = ErrorOfStratum(lit, options.floor);
+  const StratumError shadowed_error = ErrorOfStratum(shadowed, options.floor);
+  out.sunlit_error = glm::compMax(lit_error.error), out.sunlit_surfaces = lit_error.surfaces;
+  out.shadowed_error = glm::compMax(shadowed_error.error), out.shadowed_surfaces = shadowed_error.surfaces;
+  const glm::dvec3 s = lit_n > 0.0 ? glm::clamp(sun_share / lit_n, 0.0, 1.0) : glm::dvec3(0.0);
+  const glm::dvec3 q = shadowed_n > 0.0 ? glm::clamp(sky_share / shadowed_n, 1e-3, 1.0) : glm::dvec3(1.0);
+  // Without shadowed samples E_sky rests on the sunlit ones alone: their error, unamplified, is the
+  // least it can have.
+  const glm::dvec3 shadowed_delta = shadowed_n > 0.0 ? shadowed_error.error : glm::max(lit_error.error, glm::dvec3(options.floor));
+  const glm::dvec3 sky = glm::sqrt(glm::pow(shadowed_delta / q, glm::dvec3(2.0)) +
+                                   glm::pow((1.0 - q) / q * lit_error.error, glm::dvec3(2.0)));
+  out.sky = glm::min(options.z * sky, glm::dvec3(options.max_half_width));
+  out.sun_observed = lit_n > 0.0 && glm::compMin(s) >= fit_options.absent_sun_share;
+  if (out.sun_observed) {
+    const glm::dvec3 sun = glm::sqrt(glm::pow(lit_error.error / s, glm::dvec3(2.0)) + glm::pow((1.0 - s) / s * sky, glm::dvec3(2.0)));
+    out.sun = glm::min(options.z * sun, glm::dvec3(options.max_half_width));
+  } else {
+    out.sun = glm::dvec3(options.max_half_width);
+  }
+  return out;
+}
+
+IntervalBounds BoundsOf(const SunSky& light, const LightInterval& interval) {
+  IntervalBounds out;
+  for (int c = 0; c < 3; ++c) {
+    out.sun[c] = {std::max(0.0, light.sun_rgb[c] * (1.0 - interval.sun[c])), light.sun_rgb[c] * (1.0 + interval.sun[c])};
+    out.sky[c] = {std::max(0.0, light.sky_rgb[c] * (1.0 - interval.sky[c])), light.sky_rgb[c] * (1.0 + interval.sky[c])};
+  }
+  return out;
+}
+
+}  // namespace daylit::estimation

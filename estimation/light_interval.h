@@ -1,0 +1,67 @@
+// How sure one frame's E_sun and E_sky are: a 90% interval per channel, from what the frame shows,
+// never from a truth.
+//
+// The fit explains each stratum (sunlit samples, shadowed samples) as a whole, so a stratum's mean
+// residual is near zero whatever the model gets wrong; what the frame does show is how much the
+// surfaces within a stratum disagree. A surface whose light the model gets wrong (a window, clutter,
+// gloss, a wrong albedo, a transfer term off) sits away from the others by its own bias. The
+// stratum's model error δ is taken as the RMS of its surfaces' biases (each surface's mean
+// relative residual, clipped at the fit's outlier bound, weighted by its samples, the one degree of freedom the fit took from them
+// given back: × K/(K − 1) in variance for K surfaces), at least `floor`: not the spread divided by
+// √K, because what misleads one surface (the captured sky, the sky's shape, the camera's response)
+// often misleads its neighbours the same way.
+//
+// The split passes each stratum's error on to the term it does not measure, amplified where that
+// term is a small part of its light (docs/estimation.md, Confidence): with s the sun's share of the
+// sunlit samples' predicted light and q the sky's share of the shadowed samples', per channel,
+//
+//   E_sky:  e_sky² = (δ_shadowed / q)² + ((1 − q)/q · δ_sunlit)²
+//   E_sun:  e_sun² = (δ_sunlit / s)² + ((1 − s)/s · e_sky)²
+//
+// and the 90% interval is ±1.645·e (a normal error). A sun under `absent_sun_share` of the sunlit
+// samples' light is not observed: its interval says so (observed = false) rather than a width.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "estimation/sun_sky_fit.h"
+
+namespace daylit::estimation {
+
+struct LightIntervalOptions {
+  double floor = 0.02;         // the least model error of a stratum: the strata of an exact model
+                               // under the true light agree within 1-2% (tests/transfer_truth_recording_test.cc)
+  double z = 1.645;            // the normal quantile of a two-sided 90% interval
+  double max_half_width = 10;  // relative; beyond it the value says nothing (10 = ±1000%)
+  std::string Check() const;
+};
+
+// Relative half-widths of the 90% intervals (0.05: ±5%), per channel.
+struct LightInterval {
+  glm::dvec3 sun{0.0}, sky{0.0};
+  bool sun_observed = false;  // false: no sunlit samples, or the sun too weak a part of their light
+  bool known = false;         // false: nothing fitted (the interval of a held frame is the last one's)
+  // The strata's model errors (δ above, worst channel) and how many surfaces each had.
+  double sunlit_error = 0.0, shadowed_error = 0.0;
+  int sunlit_surfaces = 0, shadowed_surfaces = 0;
+};
+
+// The interval of `fit`, made from `samples`; `surface_of_pixel` is the bake's camera surface map
+// (Sample::pixel indexes it). An unusable fit gives known = false.
+LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
+                            const std::vector<Sample>& samples, const SunSkyFitSummary& fit,
+                            const std::vector<uint32_t>& surface_of_pixel);
+
+// The interval's bounds around `light` per channel: [v·(1 − h), v·(1 + h)], the low bound at
+// least 0 (x: low, y: high). A sun not observed has [0, v·(1 + max_half_width)].
+struct IntervalBounds {
+  std::array<glm::dvec2, 3> sun, sky;
+};
+IntervalBounds BoundsOf(const SunSky& light, const LightInterval& interval);
+
+}  // namespace daylit::estimation
