@@ -44,6 +44,10 @@ TEST(LightingTruthTest, EachBurstHasItsOwnMedianErrors) {
   frames[4].sunlit_samples = 0;    // burst 1: one frame with the sun up and nothing sunlit,
   frames[3].shadowed_samples = 0;  // one with nothing in shade
   frames[5].sunlit_samples = 0, frames[5].sun_up = false;  // and one with the sun down: not empty
+  for (estimation::FrameEstimate& f : frames) {  // every frame's 90% interval: ±30% on E_sun, ±10% on E_sky
+    f.interval.known = f.interval.sun_observed = true;
+    f.interval.sun = glm::dvec3(0.3), f.interval.sky = glm::dvec3(0.1);
+  }
   TruthComparison truth;
   for (size_t i = 0; i < frames.size(); ++i) truth.truth.push_back({glm::dvec3(10.0), glm::dvec3(2.0)});
   truth.truth[1].sun_rgb = glm::dvec3(0.0);  // no sun there: left out of E_sun's errors
@@ -68,8 +72,14 @@ TEST(LightingTruthTest, EachBurstHasItsOwnMedianErrors) {
   const std::string csv = BurstsCsv(bursts);
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "burst,first_frame,last_frame,frames,sun_elevation_deg,sun_r,sun_g,sun_b,sky_r,sky_g,sky_b,confidence,"
-            "min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,frames_without_shadowed,sun_error_r,"
-            "sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b");
+            "min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,frames_without_shadowed,sun_r_lo,"
+            "sun_r_hi,sun_g_lo,sun_g_hi,sun_b_lo,sun_b_hi,sky_r_lo,sky_r_hi,sky_g_lo,sky_g_hi,sky_b_lo,sky_b_hi,"
+            "frames_sun_not_observed,sun_error_r,sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b,"
+            "interval_covers");
+  // The interval: burst 0's errors (20%, 0) lie within ±30% and ±10%, burst 1's E_sky (50%) does not.
+  EXPECT_TRUE(bursts[0].interval_covers);
+  EXPECT_FALSE(bursts[1].interval_covers);
+  EXPECT_NEAR(bursts[1].sky_half_width.x, 0.1, 1e-12);
   EXPECT_NE(csv.find(",0,204,1,1,"), std::string::npos) << csv;  // burst 1: medians 0 and 204, one empty each
   // Without truth: the estimates only.
   EXPECT_FALSE(CompareBursts(frames, nullptr)[0].has_truth);
