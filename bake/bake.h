@@ -103,7 +103,8 @@ void SaveBake(const SceneBake& bake, const scene::Scene& scene, const BakeOption
 std::optional<SceneBake> LoadBake(const std::filesystem::path& dir, const std::string& hash);
 
 // `dir` unless empty, else $XDG_CACHE_HOME/daylit/<folder> (~/.cache/daylit/<folder>), where
-// <folder> is CacheFolderName(scene name).
+// <folder> is CacheFolderName(scene name). A `dir` inside the recording's folder must be a folder
+// of its own there, new, empty or holding a bake (bake.json): InputError "--cache: ..." otherwise.
 std::filesystem::path CacheDir(const scene::Scene& scene, const std::filesystem::path& dir);
 // A scene name as one folder name: characters other than letters, digits, '-', '_' and '.' become
 // '_', at most 100 of them, and a name of dots only (or none) gets "unnamed" in front. Never a

@@ -16,6 +16,7 @@
 #include "base/atomic_file.h"
 #include "base/csv.h"
 #include "base/error.h"
+#include "base/files.h"
 #include "base/log.h"
 #include "base/version.h"
 #include "capture/response.h"
@@ -160,7 +161,25 @@ std::string CacheFolderName(const std::string& scene_name) {
 }
 
 fs::path CacheDir(const scene::Scene& scene, const fs::path& dir) {
-  if (!dir.empty()) return dir;
+  if (!dir.empty()) {
+    // Inside the recording, the bake's files must not replace the recording's (a texture named
+    // camera_albedo.png): its folder of its own there is new, empty or a bake already.
+    if (IsWithin(dir, scene.folder)) {
+      if (ResolvedPath(dir) == ResolvedPath(scene.folder)) {
+        ThrowInputError("--cache: {} is the recording's folder: a bake cache goes in a folder of its own (name another "
+                        "folder)",
+                        dir.string());
+      }
+      std::error_code ec;
+      const bool holds_files = fs::is_directory(dir, ec) && !fs::is_empty(dir, ec);
+      if (holds_files && !fs::exists(dir / "bake.json", ec)) {
+        ThrowInputError("--cache: {} lies in the recording and holds files that are not a bake's: the bake would replace "
+                        "them (name another folder)",
+                        dir.string());
+      }
+    }
+    return dir;
+  }
   const char* xdg = std::getenv("XDG_CACHE_HOME");
   const char* home = std::getenv("HOME");
   const fs::path base = xdg != nullptr && *xdg != '\0' ? fs::path(xdg)

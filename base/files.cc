@@ -1,5 +1,7 @@
 #include "base/files.h"
 
+#include <algorithm>
+#include <iterator>
 #include <system_error>
 
 #include "base/error.h"
@@ -20,6 +22,18 @@ std::string WhyNotAFile(const std::filesystem::path& path) {
 
 void RequireRegularFile(const std::filesystem::path& path) {
   if (const std::string why = WhyNotAFile(path); !why.empty()) ThrowInputError("{}: {}", path.string(), why);
+}
+
+std::filesystem::path ResolvedPath(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::filesystem::path p = std::filesystem::weakly_canonical(std::filesystem::absolute(path), ec);
+  return ec ? std::filesystem::absolute(path).lexically_normal() : p;
+}
+
+bool IsWithin(const std::filesystem::path& path, const std::filesystem::path& folder) {
+  const std::filesystem::path p = ResolvedPath(path), f = ResolvedPath(folder);
+  auto [in_folder, in_path] = std::mismatch(f.begin(), f.end(), p.begin(), p.end());
+  return in_folder == f.end() || (in_folder->empty() && std::next(in_folder) == f.end());
 }
 
 }  // namespace daylit

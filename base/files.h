@@ -14,4 +14,9 @@ std::string WhyNotAFile(const std::filesystem::path& path);
 // Throws InputError "<path>: <why>" unless `path` is a regular file.
 void RequireRegularFile(const std::filesystem::path& path);
 
+// `path` absolute, through every symbolic link that exists (the final name included), normalised.
+std::filesystem::path ResolvedPath(const std::filesystem::path& path);
+// Whether `path` is `folder` or lies inside it, both resolved (ResolvedPath).
+bool IsWithin(const std::filesystem::path& path, const std::filesystem::path& folder);
+
 }  // namespace daylit

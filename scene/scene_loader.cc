@@ -17,6 +17,24 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A number of scene.json within [lo, hi], else the field's one-line error naming the range and
+// what it means. Everything downstream (the bake's rays, the GL, float maps) assumes such sizes.
+double InRange(const JsonField& field, double value, double lo, double hi, const std::string& meaning) {
+  if (!(value >= lo && value <= hi)) field.Fail(fmt::format("{:g} is outside [{:g}, {:g}] ({})", value, lo, hi, meaning));
+  return value;
+}
+
+// A point of the scene: each coordinate within kMaxObjectExtent of the origin.
+glm::dvec3 ScenePoint(const JsonField& field) {
+  const glm::dvec3 p = field.Vec3();
+  for (int i = 0; i < 3; ++i) {
+    if (!(std::abs(p[i]) <= kMaxObjectExtent)) {
+      field.Fail(fmt::format("{:g} m is beyond {:g} m of the scene's origin", p[i], kMaxObjectExtent));
+    }
+  }
+  return p;
+}
+
 // Tolerance on |RᵀR − I| for a rotation typed with ~9 significant digits.
 constexpr double kRotationTolerance = 1e-5;
 constexpr double kMaxClockOffsetS = 86400.0;  // frames.clock_offset_s: a clock a day off is not a drift
@@ -58,7 +76,9 @@ void LoadLocation(const JsonField& root, Scene* scene) {
   scene->location.longitude_deg = location.Get("longitude_deg").Number();
   if (auto e = location.Find("elevation_m")) scene->location.elevation_m = e->Number();
   if (const std::string why = scene->location.Check(); !why.empty()) location.Fail(why);
-  if (auto n = root.Find("north_azimuth_deg")) scene->north_azimuth_deg = n->Number();
+  if (auto n = root.Find("north_azimuth_deg")) {
+    scene->north_azimuth_deg = InRange(*n, n->Number(), -360.0, 360.0, "an angle in degrees");
+  }
 }
 
 void LoadModelAndSurfaces(const JsonField& root, Scene* scene) {
@@ -128,7 +148,7 @@ void LoadPose(const JsonField& camera, Scene* scene) {
     std::vector<glm::dvec3> world;
     std::vector<glm::dvec2> pixels;
     for (const JsonField& c : correspondences->Elements()) {
-      world.push_back(c.Get("world").Vec3());
+      world.push_back(ScenePoint(c.Get("world")));
       const std::vector<double> px = c.Get("pixel").Numbers();
       if (px.size() != 2) c.Get("pixel").Fail(fmt::format("expected 2 numbers, got {}", px.size()));
       pixels.emplace_back(px[0], px[1]);
@@ -155,7 +175,7 @@ void LoadPose(const JsonField& camera, Scene* scene) {
                               OrthonormalityError(r), glm::determinant(r)));
   }
   scene->cam_from_world.rotation = NearestRotation(r);
-  scene->cam_from_world.translation = pose.Get("translation").Vec3();
+  scene->cam_from_world.translation = ScenePoint(pose.Get("translation"));
 }
 
 void LoadCamera(const JsonField& root, Scene* scene) {
@@ -168,24 +188,38 @@ void LoadCamera(const JsonField& root, Scene* scene) {
     *value = f.Integer();
     if (*value <= 0 || *value > 16384) f.Fail(fmt::format("{} is outside [1, 16384]", *value));
   }
+  // A focal length of 1000 times the image's larger side is a field of view of 0.06°; the principal
+  // point lies within one image size of the image.
+  const double side = std::max(k.width, k.height);
   for (const auto& [key, value] : {std::pair{"fx", &k.fx}, std::pair{"fy", &k.fy}}) {
     const JsonField f = camera.Get(key);
     *value = f.Number();
     if (*value <= 0.0) f.Fail(fmt::format("must be > 0 (got {})", *value));
+    InRange(f, *value, 0.0, 1000.0 * side, "pixels: at most 1000 times the image's larger side");
   }
-  k.cx = camera.Get("cx").Number();
-  k.cy = camera.Get("cy").Number();
+  const JsonField cx = camera.Get("cx"), cy = camera.Get("cy");
+  k.cx = InRange(cx, cx.Number(), -k.width, 2.0 * k.width, "pixels: within one image width of the image");
+  k.cy = InRange(cy, cy.Number(), -k.height, 2.0 * k.height, "pixels: within one image height of the image");
   if (auto d = camera.Find("distortion")) {
     k.distortion = d->Numbers();
     const size_t n = k.distortion.size();
     if (n != 0 && n != 4 && n != 5 && n != 8 && n != 12 && n != 14) {
       d->Fail(fmt::format("expected 4, 5, 8, 12 or 14 coefficients (k1, k2, p1, p2, k3, ...), got {}", n));
     }
+    // OpenCV's models (radial k1-k6, tangential p1-p2, thin prism s1-s4, tilt τx-τy): calibrated
+    // lenses, fisheyes in the rational model included, stay within ±1000.
+    for (size_t i = 0; i < n; ++i) {
+      if (!(std::abs(k.distortion[i]) <= 1000.0)) {
+        d->Fail(fmt::format("coefficient {} is {:g}, outside [-1000, 1000] (OpenCV's distortion models)", i + 1,
+                            k.distortion[i]));
+      }
+    }
   }
   if (auto response = camera.Find("response")) scene->response = LoadResponse(*scene, *response);
   if (auto exposure = camera.Find("exposure")) {
     scene->exposure = exposure->Number();
     if (scene->exposure <= 0.0) exposure->Fail(fmt::format("must be > 0 (got {})", scene->exposure));
+    InRange(*exposure, scene->exposure, 0.0, 1e9, "linear pixel value per radiance unit");
   }
   LoadPose(camera, scene);
 }
@@ -199,13 +233,14 @@ void LoadEnvMap(const JsonField& root, Scene* scene) {
   spec.file = RequireFile(*scene, file);
   const std::string ext = spec.file.extension().string();
   if (ext != ".exr" && ext != ".hdr") file.Fail("expected an OpenEXR (.exr) or Radiance (.hdr) file");
-  spec.position = env->Get("position").Vec3();
+  spec.position = ScenePoint(env->Get("position"));
   const JsonField time = env->Get("time_utc");
   spec.time_utc = ParseUtcTime(time.String(), fmt::format("{}: {}", scene->file.string(), time.path()));
   if (auto sun = env->Find("sun_irradiance_rgb")) {
     spec.sun_irradiance_rgb = sun->Vec3();
     for (int c = 0; c < 3; ++c) {
-      if ((*spec.sun_irradiance_rgb)[c] < 0.0) sun->Fail("must be ≥ 0");
+      // 1e9: far beyond any sun in any map's units, and its products stay finite in float.
+      InRange(*sun, (*spec.sun_irradiance_rgb)[c], 0.0, 1e9, "the sun's DNI in the map's units");
     }
   }
   scene->envmap = spec;
@@ -231,15 +266,14 @@ void LoadFrames(const JsonField& root, Scene* scene) {
       offset->Fail(fmt::format("{} is outside [-{}, {}] (a day)", spec.clock_offset_s, kMaxClockOffsetS, kMaxClockOffsetS));
     }
   }
+  // A rate only a live device uses (docs/recording-format.md), but never an absurd one.
+  if (auto fps = frames.Find("fps")) InRange(*fps, fps->Number(), 1e-3, 1000.0, "frames per second");
   const int kinds = frames.Has("video") + frames.Has("images") + frames.Has("device");
   if (kinds != 1) frames.Fail("give exactly one of \"video\", \"images\" or \"device\"");
   if (auto device = frames.Find("device")) {
     spec.kind = FrameSourceKind::kDevice;
     spec.device = device->String();
-    if (auto fps = frames.Find("fps")) {
-      spec.fps = fps->Number();
-      if (spec.fps <= 0.0 || spec.fps > 1000.0) fps->Fail(fmt::format("{} is outside (0, 1000]", spec.fps));
-    }
+    if (auto fps = frames.Find("fps")) spec.fps = fps->Number();
     if (auto controls = frames.Find("controls")) {
       controls->WarnUnknownKeys({"exposure_100us", "gain", "white_balance_k"});
       const auto integer = [&](const char* key, std::optional<int64_t>* out) {
@@ -326,7 +360,10 @@ void LoadObjects(const JsonField& root, Scene* scene) {
       }
     }
     if (auto p = o.Find("position")) object.position = p->Vec3();
-    if (auto r = o.Find("rotation_deg")) object.rotation_deg = r->Vec3();
+    if (auto r = o.Find("rotation_deg")) {
+      object.rotation_deg = r->Vec3();
+      for (int i = 0; i < 3; ++i) InRange(*r, object.rotation_deg[i], -360.0, 360.0, "Euler angles in degrees");
+    }
     if (auto s = o.Find("scale")) {
       object.scale = s->value().is_number() ? glm::dvec3(s->Number()) : s->Vec3();
       if (glm::any(glm::lessThanEqual(object.scale, glm::dvec3(0.0)))) s->Fail("must be > 0");

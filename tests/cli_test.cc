@@ -1085,6 +1085,66 @@ TEST(CliTest, AnOutputThatNamesAnInputIsRefusedAndTheInputIsUntouched) {
   fs::remove_all(dir);
 }
 
+// Issue 52: any file already in the recording's folder is the user's, whether this run reads it
+// or not (a glTF's buffer and textures, an OBJ's .mtl), and so are the files written beside --out
+// (render's and relight's strips, replay's lighting.png, --residuals' files); a bake cache in the
+// recording is a folder of its own (new, empty or a bake); lights never writes over its probe. Each was replaced with exit 0.
+TEST(CliTest, AFileOfTheRecordingOrTheProbeIsNeverReplaced) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_keep_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const fs::path rec = dir / "rec", objects = rec / "objects";
+  fs::create_directories(objects);
+  for (const char* f : {"scene.json", "model.obj", "frames.csv", "video.mp4", "envmap.exr", "groundtruth.csv"}) {
+    fs::copy_file(fs::path(kRecording) / f, rec / f);
+  }
+  fs::create_symlink(fs::path(kRecording) / "groundtruth", rec / "groundtruth");
+  std::map<fs::path, std::string> before;
+  for (const char* f : {"x.bin", "tex.png", "a_vs_truth.png", "b_strip.png", "lighting.png", "residuals.png"}) {
+    WriteFileAtomically(objects / f, std::string("the user's ") + f);
+  }
+  WriteFileAtomically(rec / "model.mtl", "newmtl stone\n");
+  // A probe saved as errors.png, and an --out folder whose errors.csv links to another probe.
+  const fs::path probe = dir / "probe" / "errors.png", other = dir / "other.exr", out = dir / "lights";
+  fs::create_directories(probe.parent_path());
+  fs::create_directories(out);
+  fs::copy_file(fs::path(kRecording) / "envmap.exr", other);
+  WriteFileAtomically(probe, "not really a png");
+  fs::create_symlink(other, out / "errors.csv");
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    if (entry.is_regular_file()) before[entry.path()] = ReadTextFile(entry.path());
+  }
+  const std::string cache = " --cache " + std::string(DAYLIT_BINARY_DIR) + "/test-cache/courtyard-a";
+  const std::string r = rec.string(), o = objects.string();
+  const BadCall calls[] = {
+      {"estimate " + r + cache + " --out " + o + "/x.bin", "is a file of the recording"},
+      {"estimate " + r + cache + " --out " + o + "/tex.csv", "is a file of the recording"},  // its plot, tex.png
+      {"estimate " + r + cache + " --out " + r + "/model.mtl", "is a file of the recording"},
+      {"estimate " + r + cache + " --out " + dir.string() + "/e.csv --residuals " + o, "is a file of the recording"},
+      {"render " + r + cache + " --frame 40 --out " + o + "/tex.png", "is a file of the recording"},
+      {"render " + r + cache + " --frame 40 --out " + o + "/a.png", "is a file of the recording"},  // a_vs_truth.png
+      {"relight " + r + cache + " --frame 40 --like-frame 450 --out " + o + "/b.png", "is a file of the recording"},
+      {"replay " + r + cache + " --frames 5 --out " + o + "/r.mp4", "is a file of the recording"},  // lighting.png
+      {"bake " + r + " --cache " + o, "lies in the recording and holds files that are not a bake's"},
+      {"bake " + r + " --cache " + r, "is the recording's folder"},
+      {"lights " + probe.string() + " --n 1 --method mediancut --out " + probe.parent_path().string(),
+       "names a file this run reads"},
+      {"lights " + other.string() + " --n 1 --method mediancut --out " + out.string(), "names a file this run reads"},
+  };
+  for (const BadCall& call : calls) {
+    const CliRun run = Daylit(call.args);  // NOLINT
+    EXPECT_EQ(run.exit_code, 2) << call.args << "\n" << run.err;
+    EXPECT_NE(run.err.find(call.error), std::string::npos) << call.args << "\n" << run.err.substr(0, 2000);
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << call.args << "\n" << run.err.substr(0, 2000);
+  }
+  for (const auto& [path, content] : before) EXPECT_TRUE(ReadTextFile(path) == content) << path << " changed";
+  EXPECT_TRUE(fs::is_symlink(out / "errors.csv"));
+  // A new name in the recording is still written (the rule protects files, not the folder).
+  const CliRun fresh = Daylit("estimate " + r + cache + " --frames 3 --out " + r + "/fresh.csv");
+  EXPECT_EQ(fresh.exit_code, 0) << fresh.err;
+  EXPECT_TRUE(fs::is_regular_file(rec / "fresh.csv"));
+  fs::remove_all(dir);
+}
+
 // calibrate-scene on one burst (--frames 100): one time of day, so north alone is fitted and the
 // output says why; written outside the recording, its paths lead back to the recording's files;
 // what it cannot fit is refused by name.

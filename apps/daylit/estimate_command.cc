@@ -46,9 +46,15 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
                        {"the bursts' table", evaluation::BurstsCsvPath(o.out)}, {"--figures", o.figures}});
   RequireWritable("--out", o.out), RequireWritable("--plot", plot), RequireWritable("--figures", o.figures);
   const scene::Scene scene = scene::LoadScene(o.recording);
-  RefuseInputsAsOutputs(scene, {{"--out", o.out}, {"--plot (or the --out's .png)", plot},
-                                {"the bursts' table", evaluation::BurstsCsvPath(o.out)}, {"--figures", o.figures},
-                                {"--residuals", o.residuals}});
+  std::vector<std::pair<std::string, std::filesystem::path>> outputs = {
+      {"--out", o.out}, {"--plot (or the --out's .png)", plot}, {"the bursts' table", evaluation::BurstsCsvPath(o.out)},
+      {"--figures", o.figures}, {"--residuals", o.residuals}};
+  if (!o.residuals.empty()) {
+    for (const char* name : {"residuals.csv", "residuals.png", "worst_frame_residuals.png", "split_check.csv", "split_check.png"}) {
+      outputs.emplace_back(fmt::format("--residuals' {}", name), std::filesystem::path(o.residuals) / name);
+    }
+  }
+  RefuseInputsAsOutputs(scene, outputs);
   // The frames first: a camera that is not there is an error now, not after the bake.
   std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
   const std::filesystem::path dir = bake::CacheDir(scene, o.cache);

@@ -209,6 +209,18 @@ void RunLights(const LightsOptions& o) {
   if (o.threshold && !(*o.threshold > 0.0 && *o.threshold < 1.0)) {
     ThrowInputError("--threshold: {} is not a mean relative error in (0, 1)", *o.threshold);
   }
+  // Nothing it writes may be the probe, through a link or by another name.
+  std::vector<std::pair<std::string, fs::path>> outputs;
+  for (const char* name : {"errors.csv", "errors.png", "automatic.json", "sh9.json"}) {
+    outputs.emplace_back(fmt::format("--out's {}", name), fs::path(o.out) / name);
+  }
+  for (const lightfit::Method m : methods) {
+    for (const int n : counts) {
+      const std::string name = fmt::format("lights_{}_{}.json", lightfit::MethodKey(m), n);
+      outputs.emplace_back("--out's " + name, fs::path(o.out) / name);
+    }
+  }
+  RefuseInputsAsOutputs({fs::path(o.probe)}, {}, outputs);
   // The output folder first: a file in its place, or a folder that cannot be made or written, is
   // said before the probe is read.
   std::error_code ec;

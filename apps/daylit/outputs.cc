@@ -12,6 +12,7 @@
 
 #include "apps/daylit/commands.h"
 #include "base/error.h"
+#include "base/files.h"
 
 #include <fmt/format.h>
 
@@ -34,40 +35,25 @@ void RefuseSharedOutputs(const std::vector<std::pair<std::string, std::filesyste
   }
 }
 
-namespace {
-
-// `path` absolute, through every symlink that exists (the final name included), normalised.
-std::filesystem::path Resolved(const std::filesystem::path& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::path p = fs::weakly_canonical(fs::absolute(path), ec);
-  return ec ? fs::absolute(path).lexically_normal() : p;
-}
-
-// Whether `path` is `folder` or lies inside it (both resolved).
-bool Within(const std::filesystem::path& path, const std::filesystem::path& folder) {
-  auto [f, p] = std::mismatch(folder.begin(), folder.end(), path.begin(), path.end());
-  return f == folder.end() || (f->empty() && std::next(f) == folder.end());
-}
-
-}  // namespace
-
 void RefuseInputsAsOutputs(const std::vector<std::filesystem::path>& inputs,
                            const std::vector<std::filesystem::path>& input_folders,
                            const std::vector<std::pair<std::string, std::filesystem::path>>& outputs) {
-  std::vector<std::filesystem::path> files, folders;
-  for (const auto& f : inputs) files.push_back(Resolved(f));
-  for (const auto& f : input_folders) folders.push_back(Resolved(f));
+  namespace fs = std::filesystem;
+  std::vector<fs::path> files;
+  for (const auto& f : inputs) files.push_back(ResolvedPath(f));
   for (const auto& [option, path] : outputs) {
     if (path.empty()) continue;
-    const std::filesystem::path out = Resolved(path);
+    const fs::path out = ResolvedPath(path);
+    std::error_code ec;
+    const bool exists = fs::exists(out, ec);
     for (size_t i = 0; i < files.size(); ++i) {
-      if (out != files[i]) continue;
+      // The same name, or the same file by another (a hard link): device and inode.
+      if (out != files[i] && !(exists && fs::equivalent(out, files[i], ec))) continue;
       ThrowInputError("{}: {} names a file this run reads ({}): daylit does not write over its input (name another file)",
                       option, path.string(), inputs[i].string());
     }
-    for (size_t i = 0; i < folders.size(); ++i) {
-      if (!Within(out, folders[i])) continue;
+    for (size_t i = 0; i < input_folders.size(); ++i) {
+      if (!IsWithin(out, input_folders[i])) continue;
       ThrowInputError("{}: {} lies in {}, which this run reads: daylit does not write into its input (name another "
                       "folder)",
                       option, path.string(), input_folders[i].string());
@@ -79,6 +65,15 @@ void RefuseInputsAsOutputs(const scene::Scene& scene,
                            const std::vector<std::pair<std::string, std::filesystem::path>>& outputs) {
   const scene::SceneInputs in = scene::InputsOf(scene);
   RefuseInputsAsOutputs(in.files, in.folders, outputs);
+  // Any file already in the recording's folder is the user's, read by this run or not (a glTF's
+  // buffers and textures, an OBJ's .mtl, notes): never replaced. New names there may be written.
+  for (const auto& [option, path] : outputs) {
+    std::error_code ec;
+    if (path.empty() || !std::filesystem::exists(path, ec) || !IsWithin(path, scene.folder)) continue;
+    ThrowInputError("{}: {} is a file of the recording in {}: daylit does not replace a recording's files (name "
+                    "another file)",
+                    option, path.string(), scene.folder.string());
+  }
 }
 
 void RequireWritable(const std::string& option, const std::filesystem::path& path) {

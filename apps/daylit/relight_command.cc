@@ -62,6 +62,14 @@ glm::dvec3 RgbOption(const std::vector<double>& v, const char* option) {
 }
 
 // The relit frame's comparison with a real one (--like-frame), printed; the strip beside `out`.
+// F_strip.png beside --out F.png (or F.exr): the original | relit | real strip of --like-frame.
+fs::path StripPath(const fs::path& out) {
+  fs::path strip = out;
+  strip.replace_extension();
+  strip += "_strip.png";
+  return strip;
+}
+
 void CompareWithRealFrame(const scene::Scene& scene, const bake::SceneBake& baked, const relight::ImageRelighter& relighter,
                           const relight::RelightTarget& target, const estimation::FrameFit& original, const std::vector<float>& relit,
                           const estimation::FrameFit& real, const fs::path& out) {
@@ -80,9 +88,7 @@ void CompareWithRealFrame(const scene::Scene& scene, const bake::SceneBake& bake
                real.row.frame, 100 * relight::DiffuseError(baked.camera, relit.data(), truth->without.data()),
                100 * relight::DiffuseError(baked.camera, after.data(), truth->without.data()));
   }
-  fs::path strip = out;
-  strip.replace_extension();
-  strip += "_strip.png";
+  const fs::path strip = StripPath(out);
   const int w = baked.camera.width, h = baked.camera.height;
   report::WritePng(strip, {capture::EncodeToBgr8(before.data(), w, h, original.frame.exposure, &scene.response),
                            capture::EncodeToBgr8(relit.data(), w, h, real.frame.exposure, &scene.response),
@@ -218,7 +224,8 @@ void RelightVideo(const RelightOptions& o, const scene::Scene& scene, const bake
 void RunRelight(const RelightOptions& o) {
   CheckRelightOptions(o);
   const scene::Scene scene = scene::LoadScene(o.recording);
-  RefuseInputsAsOutputs(scene, {{"--out", o.out}});
+  // One frame compared with a real one writes its strip beside --out.
+  RefuseInputsAsOutputs(scene, {{"--out", o.out}, {"--out's strip", o.frame && o.like_frame ? StripPath(o.out) : fs::path()}});
   if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
   const FrameRange range = ParseFrameRange(scene, o.frames);
   const size_t position = o.frame ? scene::FramePosition(scene, *o.frame, "--frame") : 0;

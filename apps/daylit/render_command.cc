@@ -32,13 +32,21 @@ struct RenderOptions {
   std::string lighting = "volume";
 };
 
+// F_vs_truth.png beside --out F.png (or F.exr): the truth | daylit | difference strip.
+fs::path ComparisonPath(const fs::path& out) {
+  fs::path strip = out;
+  strip.replace_extension();
+  strip += "_vs_truth.png";
+  return strip;
+}
+
 void RunRender(const RenderOptions& o) {
   const fs::path out(o.out);
   const std::string ext = out.extension().string();
   if (ext != ".png" && ext != ".exr") ThrowInputError("--out: {} must end in .png or .exr", o.out);
   RequireWritable("--out", out);
   const scene::Scene scene = scene::LoadScene(o.recording);
-  RefuseInputsAsOutputs(scene, {{"--out", out}});
+  RefuseInputsAsOutputs(scene, {{"--out", out}, {"--out's comparison with the truth", ComparisonPath(out)}});
   const size_t position = scene::FramePosition(scene, o.frame, "--frame");
   render::FrameRendererOptions options;
   options.lights = render::ParseLighting(o.lighting, "--lighting");
@@ -71,9 +79,7 @@ void RunRender(const RenderOptions& o) {
   std::vector<float> linear;
   renderer.Linearize(fit.frame, &linear);
   const evaluation::CompositeFidelity f = evaluation::CompareComposite(composite, linear, truth->with, truth->without, truth->mask);
-  fs::path strip = out;
-  strip.replace_extension();
-  strip += "_vs_truth.png";
+  const fs::path strip = ComparisonPath(out);
   evaluation::WriteCompositeStrip(strip, w, h, truth->with, composite, fit.frame.exposure, scene.response);
   fmt::print("against {}: objects {:.1f}% over {} pixels, their shadows {:.1f}% over {} pixels (the frame itself "
              "{:.1f}% off the truth there)\n",
