@@ -13,6 +13,7 @@
 #include <tiny_gltf.h>
 
 #include "base/error.h"
+#include "base/files.h"
 #include "scene/model.h"
 
 namespace daylit::scene {
@@ -204,8 +205,9 @@ void AddPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& primi
 }
 
 // The files a glTF names (buffers, images), as tinygltf opens them: joined to the glTF's folder
-// and percent-decoded by tinygltf, then held to `root` here (lexically, as scene.json's paths
-// are), so that a uri "../../etc/passwd" or "%2e%2e/..." is refused, not read. No "~" expansion.
+// and percent-decoded by tinygltf, then held to `root` here, as written and where it leads, so
+// that a uri "../../etc/passwd" or "%2e%2e/...", or a link in the folder to a file outside it, is
+// refused, not read (a model file from elsewhere names them). No "~" expansion.
 struct GltfFiles {
   std::filesystem::path root;  // empty: anywhere
   std::string refused;         // the first path refused
@@ -213,7 +215,7 @@ struct GltfFiles {
   bool Allows(const std::string& file) {
     if (root.empty()) return true;
     const std::filesystem::path rel = std::filesystem::absolute(file).lexically_normal().lexically_relative(root);
-    if (!rel.empty() && *rel.begin() != "..") return true;
+    if (!rel.empty() && *rel.begin() != ".." && IsWithin(file, root)) return true;
     if (refused.empty()) refused = file;
     return false;
   }

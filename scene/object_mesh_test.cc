@@ -148,7 +148,7 @@ TEST(ObjectMeshTest, GltfMeshesAreReadWithTheirNodesAndTurnedToZUp) {
 
 // A glTF's buffer uri is held to the recording folder after tinygltf joins and percent-decodes it:
 // "../" and "%2e%2e/" climbing out are refused by name (not read), one inside is read, and with
-// no root (--allow-outside-paths) the escape is followed.
+// no root (--allow-outside-paths) the escape is followed; so is a link out of the folder refused.
 TEST(ObjectMeshTest, GltfBuffersOutsideTheRecordingAreRefused) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("daylit_gltf_root_" + std::to_string(::getpid()));
@@ -187,6 +187,17 @@ TEST(ObjectMeshTest, GltfBuffersOutsideTheRecordingAreRefused) {
       EXPECT_EQ(ObjectMesh(object).indices.size(), 3u);
     }
   }
+  // A link inside the folder to a file outside it (issue 52: read, and its size in the error): refused
+  // before it is read; a link that stays inside is followed.
+  fs::create_symlink(dir / "tri.bin", dir / "rec" / "objects" / "evil.bin");
+  fs::create_symlink(dir / "rec" / "tri.bin", dir / "rec" / "objects" / "good.bin");
+  try {
+    ObjectMesh(gltf("linked.gltf", "evil.bin"));
+    ADD_FAILURE() << "a link out of the folder was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("outside the recording folder"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(ObjectMesh(gltf("linked_inside.gltf", "good.bin")).indices.size(), 3u);
   fs::remove_all(dir);
 }
 
