@@ -10,6 +10,7 @@
 // a coarse grid, then halving steps, then a quadratic through the last grid. Headless: no GL.
 #pragma once
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -192,8 +193,13 @@ struct ShadowCheck {
   double kappa = 0.0;
   double kappa_away = 0.0;
   // What the frames' own sun adds to the agreement a sun turned away leaves: a kappa with the
-  // turned sun as its chance, (kappa − kappa_away) / (1 − kappa_away).
-  double SunSkill() const { return kappa_away >= 1.0 ? 0.0 : (kappa - kappa_away) / (1.0 - kappa_away); }
+  // turned sun as its chance, (kappa − k0) / (1 − k0), k0 = max(kappa_away, 0). A turned sun that
+  // agrees less than chance (kappa_away < 0) is no lower baseline than chance itself: taken as
+  // it was, it raised the skill of a kappa of 0.3 to 0.42 at kappa_away = −0.2.
+  double SunSkill() const {
+    const double chance = std::max(kappa_away, 0.0);
+    return chance >= 1.0 ? 0.0 : (kappa - chance) / (1.0 - chance);
+  }
   // The model, pose, north and place are the footage's, as far as its shadows tell.
   bool ModelMatchesFootage() const { return SunSkill() > kShadowCheckMinSunSkill; }
 };
