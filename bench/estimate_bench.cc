@@ -8,6 +8,7 @@
 #include "bake/bake.h"
 #include "base/log.h"
 #include "capture/video_decoder.h"
+#include "estimation/light_interval.h"
 #include "estimation/sampler.h"
 #include "estimation/temporal_filter.h"
 #include "scene/scene.h"
@@ -76,7 +77,21 @@ void BM_FitSunSky(benchmark::State& state) {
 }
 BENCHMARK(BM_FitSunSky)->Unit(benchmark::kMillisecond);
 
-// Everything after decoding and linearisation for one frame: samples, fit, filter.
+// A frame's 90% interval from its samples and fit (estimation/light_interval.h).
+void BM_LightInterval(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  Sampler sampler(c.bake, c.Capture(), *c.caster);
+  sampler.SetSun(c.sun);
+  const std::vector<Sample> samples = sampler.Draw(c.linear, c.exposure);
+  const SunSkyFitSummary fit = FitSunSky({}, samples);
+  for (auto _ : state) {
+    const LightInterval interval = IntervalOfFit({}, {}, samples, fit, c.bake.camera.surface);
+    benchmark::DoNotOptimize(interval.sun.x);
+  }
+}
+BENCHMARK(BM_LightInterval)->Unit(benchmark::kMillisecond);
+
+// Everything after decoding and linearisation for one frame: samples, fit, interval, filter.
 void BM_EstimateFrame(benchmark::State& state) {
   Courtyard& c = Courtyard::Get();
   Sampler sampler(c.bake, c.Capture(), *c.caster);
@@ -86,8 +101,10 @@ void BM_EstimateFrame(benchmark::State& state) {
   for (auto _ : state) {
     const std::vector<Sample> samples = sampler.Draw(c.linear, c.exposure);
     const SunSkyFitSummary fit = FitSunSky({}, samples);
+    const LightInterval interval = IntervalOfFit({}, {}, samples, fit, c.bake.camera.surface);
     const FilteredLight light = filter.Update(t += 0.1, fit.light, fit.confidence);
     benchmark::DoNotOptimize(light.light.sun_rgb.x);
+    benchmark::DoNotOptimize(interval.sky.x);
   }
 }
 BENCHMARK(BM_EstimateFrame)->Unit(benchmark::kMillisecond);
