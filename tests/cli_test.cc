@@ -364,6 +364,17 @@ struct BadCall {
   std::string error;  // expected on stderr
 };
 
+// Each call is refused as bad input: exit 2 and one line on stderr that holds its error.
+template <size_t N>
+void ExpectEachRefused(const BadCall (&calls)[N]) {
+  for (const BadCall& call : calls) {
+    const CliRun run = Daylit(call.args);  // NOLINT
+    EXPECT_EQ(run.exit_code, 2) << call.args << "\n" << run.err;
+    EXPECT_NE(run.err.find(call.error), std::string::npos) << call.args << "\n" << run.err.substr(0, 2000);
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << call.args << "\n" << run.err.substr(0, 2000);
+  }
+}
+
 TEST(CliTest, LightsWritesTheLightsTheirErrorsAndTheAutomaticN) {
   const fs::path out = fs::temp_directory_path() / ("daylit_cli_lights_" + std::to_string(::getpid()));
   fs::remove_all(out);
@@ -1069,12 +1080,7 @@ TEST(CliTest, AnOutputThatNamesAnInputIsRefusedAndTheInputIsUntouched) {
        "names a file this run reads"},  // its plot, b0.png
       {"results " + page.string() + " " + dir.string() + " --out " + page.string(), "names a file this run reads"},
   };
-  for (const BadCall& call : calls) {
-    const CliRun run = Daylit(call.args);  // NOLINT
-    EXPECT_EQ(run.exit_code, 2) << call.args << "\n" << run.err;
-    EXPECT_NE(run.err.find(call.error), std::string::npos) << call.args << "\n" << run.err.substr(0, 2000);
-    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << call.args << "\n" << run.err.substr(0, 2000);
-  }
+  ExpectEachRefused(calls);
   for (const auto& [path, content] : before) EXPECT_TRUE(bytes(path) == content) << path << " changed";
   EXPECT_TRUE(fs::is_symlink(linked / "video.mp4"));
   for (const fs::path& folder : {rec, linked, dir / "images"}) {
@@ -1130,12 +1136,7 @@ TEST(CliTest, AFileOfTheRecordingOrTheProbeIsNeverReplaced) {
        "names a file this run reads"},
       {"lights " + other.string() + " --n 1 --method mediancut --out " + out.string(), "names a file this run reads"},
   };
-  for (const BadCall& call : calls) {
-    const CliRun run = Daylit(call.args);  // NOLINT
-    EXPECT_EQ(run.exit_code, 2) << call.args << "\n" << run.err;
-    EXPECT_NE(run.err.find(call.error), std::string::npos) << call.args << "\n" << run.err.substr(0, 2000);
-    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << call.args << "\n" << run.err.substr(0, 2000);
-  }
+  ExpectEachRefused(calls);
   for (const auto& [path, content] : before) EXPECT_TRUE(ReadTextFile(path) == content) << path << " changed";
   EXPECT_TRUE(fs::is_symlink(out / "errors.csv"));
   // A new name in the recording is still written (the rule protects files, not the folder).
