@@ -45,8 +45,6 @@ std::string WhyCannotBind(const std::string& host, int port) {
   return why;
 }
 
-void AllowAnyOrigin(httplib::Response* res) { res->set_header("Access-Control-Allow-Origin", "*"); }
-
 void NoFrameYet(httplib::Response* res, const char* what) {
   res->status = 503;
   res->set_content(fmt::format(R"({{"error": "no {} yet"}})", what), "application/json");
@@ -86,9 +84,10 @@ LightingServer::LightingServer(const ServerOptions& options, std::string scene_j
   s.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
   s.set_write_timeout(2, 0);  // a client that cannot be written to for 2 s is closed
   s.set_keep_alive_max_count(1000);
+  // Every answer, errors and unknown paths included, may be read by a page served from elsewhere.
+  s.set_default_headers({{"Access-Control-Allow-Origin", "*"}});
 
   s.Get("/lighting", [this](const httplib::Request& req, httplib::Response& res) {
-    AllowAnyOrigin(&res);
     std::shared_ptr<const FrameLighting> latest;
     std::shared_ptr<const std::string> json;
     {
@@ -117,12 +116,10 @@ LightingServer::LightingServer(const ServerOptions& options, std::string scene_j
   });
 
   s.Get("/scene", [this](const httplib::Request&, httplib::Response& res) {
-    AllowAnyOrigin(&res);
     res.set_content(scene_json_, "application/json");
   });
 
   s.Get("/stream", [this](const httplib::Request&, httplib::Response& res) {
-    AllowAnyOrigin(&res);
     auto client = std::make_shared<Client>();
     {
       const std::lock_guard<std::mutex> lock(mutex_);
@@ -167,7 +164,6 @@ LightingServer::LightingServer(const ServerOptions& options, std::string scene_j
   });
 
   s.Get("/envmap", [this](const httplib::Request&, httplib::Response& res) {
-    AllowAnyOrigin(&res);
     std::shared_ptr<const FrameLighting> latest;
     {
       const std::lock_guard<std::mutex> lock(mutex_);
@@ -179,7 +175,6 @@ LightingServer::LightingServer(const ServerOptions& options, std::string scene_j
   });
 
   s.Get("/frame.jpg", [this](const httplib::Request&, httplib::Response& res) {
-    AllowAnyOrigin(&res);
     std::shared_ptr<const FrameLighting> latest;
     {
       const std::lock_guard<std::mutex> lock(mutex_);
@@ -193,7 +188,6 @@ LightingServer::LightingServer(const ServerOptions& options, std::string scene_j
   });
 
   s.Get("/video.mjpg", [this](const httplib::Request&, httplib::Response& res) {
-    AllowAnyOrigin(&res);
     {
       const std::lock_guard<std::mutex> lock(mutex_);
       if (!AdmitClient(&res)) return;

@@ -366,6 +366,13 @@ TEST(LightingServerTest, TheViewerIsServedFromWebOrItsAbsenceSaid) {
   EXPECT_EQ(three->status, 200);
   EXPECT_GT(three->body.size(), 100000u);
   EXPECT_EQ(client.Get("/three/../../package.json")->status, 404);  // nothing outside the mounts
+  // Every answer carries the CORS header once, an unknown path's 404 too (issue 52: it had none).
+  const httplib::Result missing = client.Get("/no-such-path");
+  ASSERT_TRUE(missing);
+  EXPECT_EQ(missing->status, 404);
+  EXPECT_EQ(missing->get_header_value("Access-Control-Allow-Origin"), "*");
+  EXPECT_EQ(missing->get_header_value_count("Access-Control-Allow-Origin"), 1u);
+  EXPECT_EQ(three->get_header_value_count("Access-Control-Allow-Origin"), 1u);
 
   ServerOptions bare;
   bare.web_dir = (std::filesystem::temp_directory_path() / "no-such-web-dir").string();
