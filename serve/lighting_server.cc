@@ -83,6 +83,10 @@ LightingServer::LightingServer(const ServerOptions& options, std::string scene_j
   const size_t threads = static_cast<size_t>(options_.max_clients) + 4;
   s.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
   s.set_write_timeout(2, 0);  // a client that cannot be written to for 2 s is closed
+  // A client that sends its request slower than that, or idles between requests, frees its worker
+  // after a second (it held one for 5 s).
+  s.set_read_timeout(1, 0);
+  s.set_keep_alive_timeout(1);
   s.set_keep_alive_max_count(1000);
   // Every answer, errors and unknown paths included, may be read by a page served from elsewhere.
   s.set_default_headers({{"Access-Control-Allow-Origin", "*"}});

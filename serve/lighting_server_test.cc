@@ -213,6 +213,36 @@ TEST(LightingServerTest, AClientThatReadsNothingLosesMessagesAndSlowsNoOne) {
   close(fd);
 }
 
+// A client that sends half a request line and stalls is closed after about a second, not held for
+// five (issue 52), and /lighting answers beside it.
+TEST(LightingServerTest, AClientThatStallsInItsRequestIsClosedSoon) {
+  LightingServer server({}, "{}");
+  server.Publish(Frame(1));
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<uint16_t>(server.port()));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)), 0);
+  const std::string half = "GET /lighting HT";
+  ASSERT_EQ(write(fd, half.data(), half.size()), static_cast<ssize_t>(half.size()));
+  const auto start = std::chrono::steady_clock::now();
+  httplib::Client client("127.0.0.1", server.port());
+  const httplib::Result res = client.Get("/lighting");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  // The server closes the stalled connection: read() returns 0 (or an error), well before 5 s.
+  timeval limit{4, 0};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &limit, sizeof(limit));
+  char byte = 0;
+  const ssize_t got = read(fd, &byte, 1);
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LE(got, 0);
+  EXPECT_LT(waited, 3.5) << "the stalled client was held " << waited << " s";
+  close(fd);
+}
+
 TEST(LightingServerTest, APortTakenIsAnInputErrorNamingItAndWhy) {
   LightingServer first({}, "{}");
   ServerOptions options;
