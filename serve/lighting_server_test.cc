@@ -183,6 +183,21 @@ TEST(LightingServerTest, ManyStreamClientsEachGetEveryFrameInOrder) {
   EXPECT_EQ(server.stats().dropped, 0u);
 }
 
+// A plain TCP connection to the server on loopback, for clients that misbehave; -1 if it fails.
+int ConnectTo(int port) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) return -1;
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)) != 0) {
+    close(fd);
+    return -1;
+  }
+  return fd;
+}
+
 // A client that connects and never reads: Publish never waits for it, it loses its oldest
 // messages once the socket's buffers are full (counted), and a client reading beside it gets the
 // frames in order, up to the last.
@@ -190,13 +205,8 @@ TEST(LightingServerTest, AClientThatReadsNothingLosesMessagesAndSlowsNoOne) {
   ServerOptions options;
   options.queued_per_client = 64;
   LightingServer server(options, "{}");
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  const int fd = ConnectTo(server.port());
   ASSERT_GE(fd, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<uint16_t>(server.port()));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ASSERT_EQ(connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)), 0);
   const std::string request = "GET /stream HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
   ASSERT_EQ(write(fd, request.data(), request.size()), static_cast<ssize_t>(request.size()));
   ASSERT_TRUE(Eventually([&] { return server.stats().clients_seen == 1; }));
@@ -218,13 +228,8 @@ TEST(LightingServerTest, AClientThatReadsNothingLosesMessagesAndSlowsNoOne) {
 TEST(LightingServerTest, AClientThatStallsInItsRequestIsClosedSoon) {
   LightingServer server({}, "{}");
   server.Publish(Frame(1));
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  const int fd = ConnectTo(server.port());
   ASSERT_GE(fd, 0);
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<uint16_t>(server.port()));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ASSERT_EQ(connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)), 0);
   const std::string half = "GET /lighting HT";
   ASSERT_EQ(write(fd, half.data(), half.size()), static_cast<ssize_t>(half.size()));
   const auto start = std::chrono::steady_clock::now();
