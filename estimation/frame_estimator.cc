@@ -155,17 +155,14 @@ FrameFit FitDecodedFrame(const scene::Scene& scene, const bake::SceneBake& bake,
 std::string EstimatesCsv(const std::vector<FrameEstimate>& frames) {
   fmt::memory_buffer out;
   fmt::format_to(std::back_inserter(out), "frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,"
-                                          "sky_g,sky_b,confidence,samples,sun_r_lo,sun_r_hi,sun_g_lo,sun_g_hi,sun_b_lo,"
-                                          "sun_b_hi,sky_r_lo,sky_r_hi,sky_g_lo,sky_g_hi,sky_b_lo,sky_b_hi\n");
+                                          "sky_g,sky_b,confidence,samples,{}\n",
+                 IntervalCsvHeader());
   for (const FrameEstimate& f : frames) {
     fmt::format_to(std::back_inserter(out), "{},{},{:.4f},{:.4f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{}",
                    f.frame, FormatUtcTime(f.time_utc), f.sun_elevation_deg, f.sun_azimuth_deg, f.light.sun_rgb.x,
                    f.light.sun_rgb.y, f.light.sun_rgb.z, f.light.sky_rgb.x, f.light.sky_rgb.y, f.light.sky_rgb.z,
                    f.confidence, f.samples);
-    const IntervalBounds bounds = BoundsOf(f.light, f.interval);
-    for (const glm::dvec2& b : bounds.sun) fmt::format_to(std::back_inserter(out), ",{:.6g},{:.6g}", b.x, b.y);
-    for (const glm::dvec2& b : bounds.sky) fmt::format_to(std::back_inserter(out), ",{:.6g},{:.6g}", b.x, b.y);
-    fmt::format_to(std::back_inserter(out), "\n");
+    fmt::format_to(std::back_inserter(out), "{}\n", IntervalCsvFields(BoundsOf(f.light, f.interval)));
   }
   return fmt::to_string(out);
 }

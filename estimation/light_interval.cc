@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
 #include <glm/gtx/component_wise.hpp>
 
 #include "base/options_check.h"
@@ -64,7 +65,7 @@ LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFit
   // misregistered edge is the fit's outlier, not a surface's bias.
   const float clip = static_cast<float>(3.0 * fit_options.cauchy_scale);
   for (const Sample& s : samples) {
-    const bool is_lit = s.sunlit && glm::compMin(s.sun) > fit_options.sunlit_threshold;
+    const bool is_lit = IsSunlit(s, fit_options);
     if (!is_lit && s.sunlit) continue;  // grazing sun: neither stratum
     const glm::vec3 sun = PredictedRadiance(s, sun_only);
     const glm::vec3 predicted = sun + PredictedRadiance(s, sky_only);
@@ -111,6 +112,18 @@ IntervalBounds BoundsOf(const SunSky& light, const LightInterval& interval) {
   for (int c = 0; c < 3; ++c) {
     out.sun[c] = {std::max(0.0, light.sun_rgb[c] * (1.0 - interval.sun[c])), light.sun_rgb[c] * (1.0 + interval.sun[c])};
     out.sky[c] = {std::max(0.0, light.sky_rgb[c] * (1.0 - interval.sky[c])), light.sky_rgb[c] * (1.0 + interval.sky[c])};
+  }
+  return out;
+}
+
+const char* IntervalCsvHeader() {
+  return "sun_r_lo,sun_r_hi,sun_g_lo,sun_g_hi,sun_b_lo,sun_b_hi,sky_r_lo,sky_r_hi,sky_g_lo,sky_g_hi,sky_b_lo,sky_b_hi";
+}
+
+std::string IntervalCsvFields(const IntervalBounds& bounds) {
+  std::string out;
+  for (const std::array<glm::dvec2, 3>* term : {&bounds.sun, &bounds.sky}) {
+    for (const glm::dvec2& b : *term) out += fmt::format(",{:.6g},{:.6g}", b.x, b.y);
   }
   return out;
 }

@@ -64,4 +64,10 @@ struct IntervalBounds {
 };
 IntervalBounds BoundsOf(const SunSky& light, const LightInterval& interval);
 
+// The bounds as CSV columns, the same in estimates.csv and bursts.csv: the header's names
+// (sun_r_lo,sun_r_hi,...,sky_b_lo,sky_b_hi, no leading comma) and one row's fields (each after a
+// comma).
+const char* IntervalCsvHeader();
+std::string IntervalCsvFields(const IntervalBounds& bounds);
+
 }  // namespace daylit::estimation

@@ -18,10 +18,6 @@ namespace {
 
 constexpr int kMinSamples = 10;
 
-bool IsSunlit(const Sample& s, const SunSkyFitOptions& options) {
-  return s.sunlit && glm::compMin(s.sun) > options.sunlit_threshold;
-}
-
 // E_sun, E_clear, E_overcast of one channel.
 using ChannelFit = std::array<double, 3>;
 
@@ -85,6 +81,10 @@ ChannelFit SolveNonNegative(const NormalEquations& eq, const std::array<bool, 3>
 }
 
 }  // namespace
+
+bool IsSunlit(const Sample& s, const SunSkyFitOptions& options) {
+  return s.sunlit && glm::compMin(s.sun) > options.sunlit_threshold;
+}
 
 std::string SunSkyFitOptions::Check() const {
   return FirstProblem({InOpenClosed("cauchy_scale", cauchy_scale, 0.0, 10.0), InClosed("iterations", iterations, 1, 1000),

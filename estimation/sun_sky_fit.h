@@ -107,6 +107,11 @@ struct SunSkyFitSummary {
   bool IsUsable() const { return status != SunSkyFitStatus::kTooFewSamples; }
 };
 
+// Whether a sample counts as sunlit (the sunlit stratum): the sun reaches it, and well, in every
+// channel (its sun term above the options' sunlit_threshold). A sample the sun reaches only at a
+// grazing angle is in neither stratum.
+bool IsSunlit(const Sample& s, const SunSkyFitOptions& options);
+
 // Fits E_sun and E_sky to `samples`. Never throws; a frame that cannot be fitted returns a
 // summary with status kTooFewSamples and a message. With `sun_colour` (RGB, > 0), the summary
 // also has the fit with E_sun that colour times one magnitude over the three channels (`coloured`).

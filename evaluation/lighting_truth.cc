@@ -169,9 +169,9 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
 std::string BurstsCsv(const std::vector<BurstLighting>& bursts) {
   const bool truth = !bursts.empty() && bursts[0].has_truth;
   std::string csv = "burst,first_frame,last_frame,frames,sun_elevation_deg,sun_r,sun_g,sun_b,sky_r,sky_g,sky_b,confidence,"
-                    "min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,frames_without_shadowed,"
-                    "sun_r_lo,sun_r_hi,sun_g_lo,sun_g_hi,sun_b_lo,sun_b_hi,sky_r_lo,sky_r_hi,sky_g_lo,sky_g_hi,sky_b_lo,"
-                    "sky_b_hi,frames_sun_not_observed";
+                    "min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,frames_without_shadowed,";
+  csv += estimation::IntervalCsvHeader();
+  csv += ",frames_sun_not_observed";
   csv += truth ? ",sun_error_r,sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b,interval_covers\n" : "\n";
   for (const BurstLighting& b : bursts) {
     csv += fmt::format("{},{},{},{},{:.3f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{:.4f}", b.burst.index,
@@ -181,9 +181,7 @@ std::string BurstsCsv(const std::vector<BurstLighting>& bursts) {
                        b.frames_without_shadowed);
     estimation::LightInterval interval;
     interval.sun = b.sun_half_width, interval.sky = b.sky_half_width;
-    const estimation::IntervalBounds bounds = estimation::BoundsOf({b.sun, b.sky}, interval);
-    for (const glm::dvec2& x : bounds.sun) csv += fmt::format(",{:.6g},{:.6g}", x.x, x.y);
-    for (const glm::dvec2& x : bounds.sky) csv += fmt::format(",{:.6g},{:.6g}", x.x, x.y);
+    csv += estimation::IntervalCsvFields(estimation::BoundsOf({b.sun, b.sky}, interval));
     csv += fmt::format(",{}", b.frames_sun_not_observed);
     if (truth) {
       csv += fmt::format(",{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{}", b.sun_error.x, b.sun_error.y, b.sun_error.z,
