@@ -1,0 +1,109 @@
+#!/usr/bin/env bash
+# The test set of docs/estimation.md: the bundled recordings and the generated scenes of scenes/.
+#
+#   bash scripts/scenes.sh render [NAME...]   render scenes/NAME.json (default: all) with the generator
+#                                             beside the project (../shared/recgen; Blender 3.4 Cycles:
+#                                             apt-get install blender ffmpeg python3-astropy
+#                                             python3-opencv python3-numpy) into build/scenes/NAME.
+#                                             Resumable: an image already rendered is kept. Minutes
+#                                             per scene on 2 cores; run it in the background.
+#   bash scripts/scenes.sh measure [NAME...]  daylit estimate on each recording (default: every bundled
+#                                             and every rendered one), then the table of
+#                                             docs/estimation.md ("The test set") on stdout, from
+#                                             each run's figures (build/scenes/figures/NAME.json).
+#
+# daylit never needs the generator: the scenes are rendered once, here, and measured like any
+# recording. A scene's README (written by the generator) says what it is.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$PWD
+recgen=${RECGEN:-$root/../shared/recgen}
+out=$root/build/scenes
+mode=${1:-}
+shift || true
+
+scene_names() {
+  if (($#)); then printf '%s\n' "$@"; else for c in scenes/*.json; do basename "$c" .json; done; fi
+}
+
+render() {
+  [[ -f $recgen/render_bases.py ]] || { echo "scenes.sh: no generator at $recgen (set RECGEN)" >&2; exit 1; }
+  command -v blender >/dev/null || { echo "scenes.sh: blender is not installed (see this script's header)" >&2; exit 1; }
+  # A copy of the generator, with one fix: its README text reads the Nishita sky's densities even in
+  # a scene whose skies are all sky textures (no "sky" block), and fails there after the recording
+  # is written.
+  rm -rf "$out/recgen"
+  mkdir -p "$out/recgen"
+  cp "$recgen"/*.py "$out/recgen/"
+  sed -i 's/cfg\["sky"\]\["\(air_density\|dust_density\|ozone_density\)"\]/cfg.get("sky", {}).get("\1", float("nan"))/g' \
+    "$out/recgen/readme_text.py"
+  local gen=$out/recgen name cfg work
+  for name in $(scene_names "$@"); do
+    cfg=$root/scenes/$name.json
+    [[ -f $cfg ]] || { echo "scenes.sh: no scene description $cfg" >&2; exit 2; }
+    work=$out/$name/work
+    mkdir -p "$work"
+    echo "scenes: rendering $name ($(date +%T))" >&2
+    [[ -s $work/bursts.json ]] || python3 "$gen/sunpos_bursts.py" "$cfg" >"$work/bursts.json.tmp"
+    [[ -s $work/bursts.json ]] || mv "$work/bursts.json.tmp" "$work/bursts.json"
+    if grep -q '"probe_sky"' "$cfg"; then python3 "$gen/probe_sky.py" "$cfg" "$work" >/dev/null; fi
+    nice -n 19 blender -b --factory-startup --python "$gen/render_bases.py" -- \
+      --config "$cfg" --bursts "$work/bursts.json" --work "$work" >"$work/render.log" 2>&1 ||
+      { echo "scenes.sh: the render of $name failed, see $work/render.log" >&2; exit 1; }
+    rm -rf "$out/$name/recording.tmp"
+    python3 "$gen/compose.py" "$cfg" "$work" "$out/$name/recording.tmp" >"$work/compose.log"
+    python3 "$gen/add_without_objects.py" "$work" "$out/$name/recording.tmp" >>"$work/compose.log"
+    python3 "$gen/verify.py" "$cfg" "$work" "$out/$name/recording.tmp" "$work/checks.json" >"$work/verify.log" ||
+      echo "scenes: $name: the generator's own checks failed, see $work/verify.log" >&2
+    rm -rf "$out/$name/recording"
+    mv "$out/$name/recording.tmp" "$out/$name/recording"
+  done
+}
+
+measure() {
+  local recordings=() name rec
+  if (($#)); then
+    for name in "$@"; do
+      if [[ -d recordings/$name ]]; then recordings+=("recordings/$name"); else recordings+=("$out/$name/recording"); fi
+    done
+  else
+    for rec in recordings/*/ "$out"/*/recording/; do [[ -f $rec/scene.json ]] && recordings+=("${rec%/}"); done
+  fi
+  bash scripts/build.sh --main >/dev/null
+  mkdir -p "$out/figures" "$out/estimates"
+  for rec in "${recordings[@]}"; do
+    [[ -f $rec/scene.json ]] || { echo "scenes.sh: no recording at $rec (render it first)" >&2; exit 2; }
+    name=$(basename "$rec"); [[ $name == recording ]] && name=$(basename "$(dirname "$rec")")
+    echo "scenes: estimating $name" >&2
+    build/bin/daylit -q estimate "$rec" --cache "$out/cache/$name" --out "$out/estimates/$name.csv" \
+      --figures "$out/figures/$name.json" >/dev/null
+  done
+  # One row per scene: the worst burst (median over the burst, per channel), the p90 of the frames'
+  # worst channel, the frames beyond 10%, and the 90% interval: bursts it holds, median half-widths.
+  python3 - "$out/figures" "${recordings[@]}" <<'EOF'
+import json, os, sys
+figs = sys.argv[1]
+print("| scene | worst burst | p90 | frames > 10% | interval holds | half-width E_sun / E_sky |")
+print("| --- | --- | --- | --- | --- | --- |")
+for rec in sys.argv[2:]:
+    name = os.path.basename(rec) if os.path.basename(rec) != "recording" else os.path.basename(os.path.dirname(rec))
+    f = json.load(open(os.path.join(figs, name + ".json")))
+    worst, where = 0.0, ""
+    for k in range(int(f["lighting/bursts"])):
+        for q in ("sun", "sky"):
+            for c in "rgb":
+                v = f.get("lighting/burst/%d/%s_error/%s" % (k, q, c))
+                if v is not None and abs(v) > abs(worst):
+                    worst, where = v, "burst %d E_%s %s" % (k, q, c)
+    print("| %s | %.1f%% (%s) | %.1f%% | %d / %d | %d / %d | %.1f / %.1f%% |" % (
+        name, 100 * worst, where, 100 * f["lighting/p90_worst_channel_error"], f["lighting/bad_frames"],
+        f["lighting/frames"], f["lighting/interval/covered_bursts"], f["lighting/interval/bursts"],
+        100 * f["lighting/interval/sun_half_width"], 100 * f["lighting/interval/sky_half_width"]))
+EOF
+}
+
+case $mode in
+  render) render "$@" ;;
+  measure) measure "$@" ;;
+  *) echo "usage: bash scripts/scenes.sh render|measure [NAME...]" >&2; exit 2 ;;
+esac
