@@ -19,6 +19,7 @@ cd "$(dirname "$0")/.."
 root=$PWD
 recgen=${RECGEN:-$root/../shared/recgen}
 out=$root/build/scenes
+py=/usr/bin/python3  # Debian's, with the generator's modules (not a python3 of a virtual environment)
 mode=${1:-}
 shift || true
 
@@ -44,16 +45,16 @@ render() {
     work=$out/$name/work
     mkdir -p "$work"
     echo "scenes: rendering $name ($(date +%T))" >&2
-    [[ -s $work/bursts.json ]] || python3 "$gen/sunpos_bursts.py" "$cfg" >"$work/bursts.json.tmp"
+    [[ -s $work/bursts.json ]] || "$py" "$gen/sunpos_bursts.py" "$cfg" >"$work/bursts.json.tmp"
     [[ -s $work/bursts.json ]] || mv "$work/bursts.json.tmp" "$work/bursts.json"
-    if grep -q '"probe_sky"' "$cfg"; then python3 "$gen/probe_sky.py" "$cfg" "$work" >/dev/null; fi
+    if grep -q '"probe_sky"' "$cfg"; then "$py" "$gen/probe_sky.py" "$cfg" "$work" >/dev/null; fi
     nice -n 19 blender -b --factory-startup --python "$gen/render_bases.py" -- \
       --config "$cfg" --bursts "$work/bursts.json" --work "$work" >"$work/render.log" 2>&1 ||
       { echo "scenes.sh: the render of $name failed, see $work/render.log" >&2; exit 1; }
     rm -rf "$out/$name/recording.tmp"
-    python3 "$gen/compose.py" "$cfg" "$work" "$out/$name/recording.tmp" >"$work/compose.log"
-    python3 "$gen/add_without_objects.py" "$work" "$out/$name/recording.tmp" >>"$work/compose.log"
-    python3 "$gen/verify.py" "$cfg" "$work" "$out/$name/recording.tmp" "$work/checks.json" >"$work/verify.log" ||
+    "$py" "$gen/compose.py" "$cfg" "$work" "$out/$name/recording.tmp" >"$work/compose.log"
+    "$py" "$gen/add_without_objects.py" "$work" "$out/$name/recording.tmp" >>"$work/compose.log"
+    "$py" "$gen/verify.py" "$cfg" "$work" "$out/$name/recording.tmp" "$work/checks.json" >"$work/verify.log" ||
       echo "scenes: $name: the generator's own checks failed, see $work/verify.log" >&2
     rm -rf "$out/$name/recording"
     mv "$out/$name/recording.tmp" "$out/$name/recording"
@@ -80,7 +81,7 @@ measure() {
   done
   # One row per scene: the worst burst (median over the burst, per channel), the p90 of the frames'
   # worst channel, the frames beyond 10%, and the 90% interval: bursts it holds, median half-widths.
-  python3 - "$out/figures" "${recordings[@]}" <<'EOF'
+  "$py" - "$out/figures" "${recordings[@]}" <<'EOF'
 import json, os, sys
 figs = sys.argv[1]
 print("| scene | worst burst | p90 | frames > 10% | interval holds | half-width E_sun / E_sky |")
