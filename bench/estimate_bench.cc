@@ -98,16 +98,37 @@ void BM_EstimateFrame(benchmark::State& state) {
   sampler.SetSun(c.sun);
   TemporalFilter filter(TemporalFilterOptions{});
   double t = 0.0;
+  const LightIntervalOptions interval_options;
+  SkyShapeSpread shape;
+  long frame = 0;
   for (auto _ : state) {
     const std::vector<Sample> samples = sampler.Draw(c.linear, c.exposure);
     const SunSkyFitSummary fit = FitSunSky({}, samples);
-    const LightInterval interval = IntervalOfFit({}, {}, samples, fit, c.bake.camera.surface);
+    // The sky shape's refits once a second, as the estimator makes them: every tenth frame at 10 fps.
+    if (frame++ % 10 == 0) {
+      shape = SkyShapeSpreadOfFit(interval_options, {}, samples, fit, c.bake.camera.surface);
+    }
+    const LightInterval interval = IntervalOfFit(interval_options, {}, samples, fit, c.bake.camera.surface, shape);
     const FilteredLight light = filter.Update(t += 0.1, fit.light, fit.confidence);
     benchmark::DoNotOptimize(light.light.sun_rgb.x);
     benchmark::DoNotOptimize(interval.sky.x);
   }
 }
 BENCHMARK(BM_EstimateFrame)->Unit(benchmark::kMillisecond);
+
+// The sky shape's two refits of one frame (estimation/light_interval.h), made once a second.
+void BM_SkyShapeSpread(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  Sampler sampler(c.bake, c.Capture(), *c.caster);
+  sampler.SetSun(c.sun);
+  const std::vector<Sample> samples = sampler.Draw(c.linear, c.exposure);
+  const SunSkyFitSummary fit = FitSunSky({}, samples);
+  for (auto _ : state) {
+    const SkyShapeSpread shape = SkyShapeSpreadOfFit({}, {}, samples, fit, c.bake.camera.surface);
+    benchmark::DoNotOptimize(shape.sky.x);
+  }
+}
+BENCHMARK(BM_SkyShapeSpread)->Unit(benchmark::kMillisecond);
 
 // A sun move: shadow rays for every model pixel, new strata, transfer terms of the pools (paths
 // already traced: the first move traces them, which is timed apart).

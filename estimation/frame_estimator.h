@@ -90,6 +90,8 @@ class FrameEstimator {
   std::optional<UtcTime> first_utc_;
   double overcast_share_ = 0.0;
   LightInterval interval_;  // the last usable fit's
+  SkyShapeSpread sky_shape_;              // the last one made (LightIntervalOptions::sky_shape_every_s)
+  std::optional<double> sky_shape_at_s_;  // when, in seconds since the first frame
   SunColourMemory sun_colour_;
 };
 

@@ -41,26 +41,29 @@ StratumError ErrorOfStratum(const std::vector<SurfaceResiduals>& surfaces, doubl
   return out;
 }
 
-}  // namespace
+// The strata's model errors of `fit` on `samples` and the shares the split passes them on by.
+struct StrataErrors {
+  StratumError lit, shadowed;
+  double lit_n = 0.0, shadowed_n = 0.0;
+  glm::dvec3 s{0.0}, q{1.0};  // the sun's share of the sunlit samples' light, the sky's of the shadowed ones'
+  // Σ over both strata of surfaces × δ² (worst channel): how much the surfaces disagree, all told.
+  double Disagreement() const {
+    const double a = glm::compMax(lit.error), b = glm::compMax(shadowed.error);
+    return lit.surfaces * a * a + shadowed.surfaces * b * b;
+  }
+  int Surfaces() const { return lit.surfaces + shadowed.surfaces; }
+};
 
-std::string LightIntervalOptions::Check() const {
-  return FirstProblem({InOpenClosed("floor", floor, 0.0, 1.0), InOpenClosed("z", z, 0.0, 10.0),
-                       InOpenClosed("max_half_width", max_half_width, 0.0, 1e6)});
-}
-
-LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
-                            const std::vector<Sample>& samples, const SunSkyFitSummary& fit,
-                            const std::vector<uint32_t>& surface_of_pixel) {
-  LightInterval out;
-  if (!fit.IsUsable()) return out;
-  out.known = true;
+StrataErrors ErrorsOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
+                         const std::vector<Sample>& samples, const SunSkyFitSummary& fit,
+                         const std::vector<uint32_t>& surface_of_pixel) {
+  StrataErrors out;
   const LightParts all = SplitLight(fit.light, fit.overcast_share);
   const LightParts sun_only{all.sun, glm::vec3(0.0f), glm::vec3(0.0f)}, sky_only{glm::vec3(0.0f), all.clear, all.overcast};
   // Relative residuals by stratum and surface, and each stratum's share of its light from the term
   // it measures (a mean of shares, as the fit's SplitShares).
   std::vector<SurfaceResiduals> lit, shadowed;  // by surface
   glm::dvec3 sun_share(0.0), sky_share(0.0);
-  double lit_n = 0.0, shadowed_n = 0.0;
   // Clipped where the fit stops counting a sample as an inlier (3 Cauchy scales): a walker or a
   // misregistered edge is the fit's outlier, not a surface's bias.
   const float clip = static_cast<float>(3.0 * fit_options.cauchy_scale);
@@ -80,27 +83,86 @@ LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFit
     r.sum += glm::dvec3(glm::clamp(s.radiance / predicted - 1.0f, -clip, clip));
     r.n += 1.0;
     if (is_lit) {
-      sun_share += glm::dvec3(sun / predicted), lit_n += 1.0;
+      sun_share += glm::dvec3(sun / predicted), out.lit_n += 1.0;
     } else {
-      sky_share += glm::dvec3(1.0f - sun / predicted), shadowed_n += 1.0;
+      sky_share += glm::dvec3(1.0f - sun / predicted), out.shadowed_n += 1.0;
     }
   }
-  const StratumError lit_error = ErrorOfStratum(lit, options.floor);
-  const StratumError shadowed_error = ErrorOfStratum(shadowed, options.floor);
+  out.lit = ErrorOfStratum(lit, options.floor);
+  out.shadowed = ErrorOfStratum(shadowed, options.floor);
+  out.s = out.lit_n > 0.0 ? glm::clamp(sun_share / out.lit_n, 0.0, 1.0) : glm::dvec3(0.0);
+  out.q = out.shadowed_n > 0.0 ? glm::clamp(sky_share / out.shadowed_n, 1e-3, 1.0) : glm::dvec3(1.0);
+  return out;
+}
+
+}  // namespace
+
+std::string LightIntervalOptions::Check() const {
+  return FirstProblem({InOpenClosed("floor", floor, 0.0, 1.0), InOpenClosed("z", z, 0.0, 10.0),
+                       InOpenClosed("max_half_width", max_half_width, 0.0, 1e6),
+                       InClosed("sky_shape_iterations", sky_shape_iterations, 1, 100),
+                       InClosed("sky_shape_every_s", sky_shape_every_s, 0.0, 3600.0)});
+}
+
+SkyShapeSpread SkyShapeSpreadOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
+                                   const std::vector<Sample>& samples, const SunSkyFitSummary& fit,
+                                   const std::vector<uint32_t>& surface_of_pixel) {
+  SkyShapeSpread out;
+  if (!fit.IsUsable()) return out;
+  const StrataErrors own = ErrorsOfFit(options, fit_options, samples, fit, surface_of_pixel);
+  const int k = own.Surfaces();
+  const double own_disagreement = own.Disagreement();
+  if (k < 2 || !(own_disagreement > 0.0)) return out;
+  SunSkyFitOptions alternative_options = fit_options;
+  alternative_options.iterations = std::min(fit_options.iterations, options.sky_shape_iterations);
+  double weights = 1.0;  // the fit's own shape, at zero distance from itself
+  std::vector<Sample> shaped = samples;
+  for (const bool clear : {true, false}) {
+    // The whole sky of one shape: the captured clear sky's, or a uniform one's.
+    for (size_t i = 0; i < samples.size(); ++i) {
+      shaped[i].sky = clear ? samples[i].sky : samples[i].overcast;
+      shaped[i].overcast = shaped[i].sky;
+    }
+    const SunSkyFitSummary alternative = FitSunSky(alternative_options, shaped);
+    if (!alternative.IsUsable()) continue;
+    const StrataErrors errors = ErrorsOfFit(options, fit_options, shaped, alternative, surface_of_pixel);
+    // Its likelihood relative to the fit's own, the surfaces' biases taken as normal with a common
+    // unknown variance (profiled out): (D²_alternative / D²_own)^(−K/2).
+    const double weight = std::pow(std::max(errors.Disagreement() / own_disagreement, 1e-6), -0.5 * k);
+    weights += weight;
+    for (int c = 0; c < 3; ++c) {
+      if (fit.light.sun_rgb[c] > 0.0f) out.sun[c] += weight * std::pow(alternative.light.sun_rgb[c] / fit.light.sun_rgb[c] - 1.0, 2.0);
+      if (fit.light.sky_rgb[c] > 0.0f) out.sky[c] += weight * std::pow(alternative.light.sky_rgb[c] / fit.light.sky_rgb[c] - 1.0, 2.0);
+    }
+  }
+  out.sun = glm::sqrt(out.sun / weights);
+  out.sky = glm::sqrt(out.sky / weights);
+  return out;
+}
+
+LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
+                            const std::vector<Sample>& samples, const SunSkyFitSummary& fit,
+                            const std::vector<uint32_t>& surface_of_pixel, const SkyShapeSpread& shape) {
+  LightInterval out;
+  if (!fit.IsUsable()) return out;
+  out.known = true;
+  const StrataErrors strata = ErrorsOfFit(options, fit_options, samples, fit, surface_of_pixel);
+  const StratumError& lit_error = strata.lit;
+  const StratumError& shadowed_error = strata.shadowed;
   out.sunlit_error = glm::compMax(lit_error.error), out.sunlit_surfaces = lit_error.surfaces;
   out.shadowed_error = glm::compMax(shadowed_error.error), out.shadowed_surfaces = shadowed_error.surfaces;
-  const glm::dvec3 s = lit_n > 0.0 ? glm::clamp(sun_share / lit_n, 0.0, 1.0) : glm::dvec3(0.0);
-  const glm::dvec3 q = shadowed_n > 0.0 ? glm::clamp(sky_share / shadowed_n, 1e-3, 1.0) : glm::dvec3(1.0);
+  const glm::dvec3 s = strata.s, q = strata.q;
+  out.sky_shape = shape;
   // Without shadowed samples E_sky rests on the sunlit ones alone: their error, unamplified, is the
   // least it can have.
-  const glm::dvec3 shadowed_delta = shadowed_n > 0.0 ? shadowed_error.error : glm::max(lit_error.error, glm::dvec3(options.floor));
+  const glm::dvec3 shadowed_delta = strata.shadowed_n > 0.0 ? shadowed_error.error : glm::max(lit_error.error, glm::dvec3(options.floor));
   const glm::dvec3 sky = glm::sqrt(glm::pow(shadowed_delta / q, glm::dvec3(2.0)) +
                                    glm::pow((1.0 - q) / q * lit_error.error, glm::dvec3(2.0)));
-  out.sky = glm::min(options.z * sky, glm::dvec3(options.max_half_width));
-  out.sun_observed = lit_n > 0.0 && glm::compMin(s) >= fit_options.absent_sun_share;
+  out.sky = glm::min(options.z * glm::sqrt(sky * sky + shape.sky * shape.sky), glm::dvec3(options.max_half_width));
+  out.sun_observed = strata.lit_n > 0.0 && glm::compMin(s) >= fit_options.absent_sun_share;
   if (out.sun_observed) {
     const glm::dvec3 sun = glm::sqrt(glm::pow(lit_error.error / s, glm::dvec3(2.0)) + glm::pow((1.0 - s) / s * sky, glm::dvec3(2.0)));
-    out.sun = glm::min(options.z * sun, glm::dvec3(options.max_half_width));
+    out.sun = glm::min(options.z * glm::sqrt(sun * sun + shape.sun * shape.sun), glm::dvec3(options.max_half_width));
   } else {
     out.sun = glm::dvec3(options.max_half_width);
   }

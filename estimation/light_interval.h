@@ -18,8 +18,10 @@
 //   E_sky:  e_sky² = (δ_shadowed / q)² + ((1 − q)/q · δ_sunlit)²
 //   E_sun:  e_sun² = (δ_sunlit / s)² + ((1 − s)/s · e_sky)²
 //
-// and the 90% interval is ±1.645·e (a normal error). A sun under `absent_sun_share` of the sunlit
-// samples' light is not observed: its interval says so (observed = false) rather than a width.
+// and the 90% interval is ±1.645·e (a normal error), with the sky shape's spread (SkyShapeSpreadOfFit,
+// what the frame cannot tell of the sky's shape) added to e in quadrature. A sun under
+// `absent_sun_share` of the sunlit samples' light is not observed: its interval says so
+// (observed = false) rather than a width.
 #pragma once
 
 #include <array>
@@ -38,7 +40,20 @@ struct LightIntervalOptions {
                                // under the true light agree within 1-2% (tests/transfer_truth_recording_test.cc)
   double z = 1.645;            // the normal quantile of a two-sided 90% interval
   double max_half_width = 10;  // relative; beyond it the value says nothing (10 = ±1000%)
+  // The sky's shape (SkyShapeSpreadOfFit): its refits take `sky_shape_iterations` of the fit's
+  // reweighting steps, and the estimator makes them on a usable frame at least `sky_shape_every_s`
+  // after the last that had them (a cloud's passing takes a second or more), the frames between
+  // keeping the last spread: two refits a second whatever the frame rate.
+  bool sky_shape = true;
+  int sky_shape_iterations = 3;
+  double sky_shape_every_s = 1.0;
   std::string Check() const;
+};
+
+// How far E_sun and E_sky move with the sky's shape, as far as the frame cannot tell that shape:
+// relative, one standard deviation, per channel.
+struct SkyShapeSpread {
+  glm::dvec3 sun{0.0}, sky{0.0};
 };
 
 // Relative half-widths of the 90% intervals (0.05: ±5%), per channel.
@@ -49,13 +64,30 @@ struct LightInterval {
   // The strata's model errors (δ above, worst channel) and how many surfaces each had.
   double sunlit_error = 0.0, shadowed_error = 0.0;
   int sunlit_surfaces = 0, shadowed_surfaces = 0;
+  // The sky shape's part (SkyShapeSpreadOfFit) that the interval includes.
+  SkyShapeSpread sky_shape;
 };
 
 // The interval of `fit`, made from `samples`; `surface_of_pixel` is the bake's camera surface map
-// (Sample::pixel indexes it). An unusable fit gives known = false.
+// (Sample::pixel indexes it). An unusable fit gives known = false. `shape`'s spread is added to
+// each term's in quadrature.
 LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
                             const std::vector<Sample>& samples, const SunSkyFitSummary& fit,
-                            const std::vector<uint32_t>& surface_of_pixel);
+                            const std::vector<uint32_t>& surface_of_pixel, const SkyShapeSpread& shape = {});
+
+// The sky's shape. The fit mixes two: the captured clear sky re-aimed (E_clear) and a uniform one
+// (E_overcast). A sky of another shape (another haze, thin cloud, a photographed sky unlike the
+// capture's) moves E_sky by tens of percent while the fit still explains the frame, and the
+// surfaces' disagreement above does not show it. So the frame is refitted with its whole sky of
+// each shape; each refit is weighed by its likelihood against the fit's own, the surfaces' biases
+// taken as normal with an unknown common variance (profiled out): (D²_refit / D²_own)^(−K/2), D²
+// the sum over both strata of surfaces × δ² and K the surfaces. The spread is the root of the
+// weighted mean square of the refits' relative differences in E_sun and E_sky from the fit's (the
+// fit's own shape counted with weight 1 and difference 0): the between-model part of a Bayesian
+// model average's variance.
+SkyShapeSpread SkyShapeSpreadOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
+                                   const std::vector<Sample>& samples, const SunSkyFitSummary& fit,
+                                   const std::vector<uint32_t>& surface_of_pixel);
 
 // The interval's bounds around `light` per channel: [v·(1 − h), v·(1 + h)], the low bound at
 // least 0 (x: low, y: high). A sun not observed has [0, v·(1 + max_half_width)].

@@ -11,6 +11,7 @@
 #                                             and every rendered one), then the table of
 #                                             docs/estimation.md ("The test set") on stdout, from
 #                                             each run's figures (build/scenes/figures/NAME.json).
+#   bash scripts/scenes.sh table [NAME...]     the table again from the figures already measured.
 #
 # daylit never needs the generator: the scenes are rendered once, here, and measured like any
 # recording. A scene's README (written by the generator) says what it is.
@@ -61,8 +62,9 @@ render() {
   done
 }
 
-measure() {
-  local recordings=() name rec
+recordings_of() {
+  local name rec
+  recordings=()
   if (($#)); then
     for name in "$@"; do
       if [[ -d recordings/$name ]]; then recordings+=("recordings/$name"); else recordings+=("$out/$name/recording"); fi
@@ -70,6 +72,11 @@ measure() {
   else
     for rec in recordings/*/ "$out"/*/recording/; do [[ -f $rec/scene.json ]] && recordings+=("${rec%/}"); done
   fi
+}
+
+measure() {
+  local recordings name rec
+  recordings_of "$@"
   bash scripts/build.sh --main >/dev/null
   mkdir -p "$out/figures" "$out/estimates"
   for rec in "${recordings[@]}"; do
@@ -79,6 +86,12 @@ measure() {
     build/bin/daylit -q estimate "$rec" --cache "$out/cache/$name" --out "$out/estimates/$name.csv" \
       --figures "$out/figures/$name.json" >/dev/null
   done
+  table "$@"
+}
+
+table() {
+  local recordings
+  recordings_of "$@"
   # One row per scene: the worst burst (median over the burst, per channel), the p90 of the frames'
   # worst channel, the frames beyond 10%, and the 90% interval: bursts it holds, median half-widths.
   "$py" - "$out/figures" "${recordings[@]}" <<'EOF'
@@ -106,5 +119,6 @@ EOF
 case $mode in
   render) render "$@" ;;
   measure) measure "$@" ;;
-  *) echo "usage: bash scripts/scenes.sh render|measure [NAME...]" >&2; exit 2 ;;
+  table) table "$@" ;;
+  *) echo "usage: bash scripts/scenes.sh render|measure|table [NAME...]" >&2; exit 2 ;;
 esac
