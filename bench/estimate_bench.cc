@@ -104,8 +104,8 @@ void BM_EstimateFrame(benchmark::State& state) {
   for (auto _ : state) {
     const std::vector<Sample> samples = sampler.Draw(c.linear, c.exposure);
     const SunSkyFitSummary fit = FitSunSky({}, samples);
-    // The sky shape's refits once a second, as the estimator makes them: every tenth frame at 10 fps.
-    if (frame++ % 10 == 0) {
+    // The sky shape's refits every two seconds, as the estimator makes them: every twentieth frame at 10 fps.
+    if (frame++ % 20 == 0) {
       shape = SkyShapeSpreadOfFit(interval_options, {}, samples, fit, c.bake.camera.surface);
     }
     const LightInterval interval = IntervalOfFit(interval_options, {}, samples, fit, c.bake.camera.surface, shape);
@@ -116,7 +116,7 @@ void BM_EstimateFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_EstimateFrame)->Unit(benchmark::kMillisecond);
 
-// The sky shape's two refits of one frame (estimation/light_interval.h), made once a second.
+// The sky shape's two refits of one frame (estimation/light_interval.h), made every two seconds.
 void BM_SkyShapeSpread(benchmark::State& state) {
   Courtyard& c = Courtyard::Get();
   Sampler sampler(c.bake, c.Capture(), *c.caster);

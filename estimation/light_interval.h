@@ -42,11 +42,11 @@ struct LightIntervalOptions {
   double max_half_width = 10;  // relative; beyond it the value says nothing (10 = ±1000%)
   // The sky's shape (SkyShapeSpreadOfFit): its refits take `sky_shape_iterations` of the fit's
   // reweighting steps, and the estimator makes them on a usable frame at least `sky_shape_every_s`
-  // after the last that had them (a cloud's passing takes a second or more), the frames between
-  // keeping the last spread: two refits a second whatever the frame rate.
+  // after the last that had them (a cloud takes seconds to pass), the frames between keeping the
+  // last spread: the same cost a second whatever the frame rate.
   bool sky_shape = true;
   int sky_shape_iterations = 3;
-  double sky_shape_every_s = 1.0;
+  double sky_shape_every_s = 2.0;
   std::string Check() const;
 };
 
