@@ -77,15 +77,25 @@ void BM_FitSunSky(benchmark::State& state) {
 }
 BENCHMARK(BM_FitSunSky)->Unit(benchmark::kMillisecond);
 
+// The courtyard frame's samples and their fit: what the benchmarks of the steps after the fit start from.
+struct FittedFrame {
+  std::vector<Sample> samples;
+  SunSkyFitSummary fit;
+};
+FittedFrame FitCourtyardFrame(Courtyard& c) {
+  Sampler sampler(c.bake, c.Capture(), *c.caster);
+  sampler.SetSun(c.sun);
+  FittedFrame out{sampler.Draw(c.linear, c.exposure), {}};
+  out.fit = FitSunSky({}, out.samples);
+  return out;
+}
+
 // A frame's 90% interval from its samples and fit (estimation/light_interval.h).
 void BM_LightInterval(benchmark::State& state) {
   Courtyard& c = Courtyard::Get();
-  Sampler sampler(c.bake, c.Capture(), *c.caster);
-  sampler.SetSun(c.sun);
-  const std::vector<Sample> samples = sampler.Draw(c.linear, c.exposure);
-  const SunSkyFitSummary fit = FitSunSky({}, samples);
+  const FittedFrame f = FitCourtyardFrame(c);
   for (auto _ : state) {
-    const LightInterval interval = IntervalOfFit({}, {}, samples, fit, c.bake.camera.surface);
+    const LightInterval interval = IntervalOfFit({}, {}, f.samples, f.fit, c.bake.camera.surface);
     benchmark::DoNotOptimize(interval.sun.x);
   }
 }
@@ -119,12 +129,9 @@ BENCHMARK(BM_EstimateFrame)->Unit(benchmark::kMillisecond);
 // The sky shape's two refits of one frame (estimation/light_interval.h), made every two seconds.
 void BM_SkyShapeSpread(benchmark::State& state) {
   Courtyard& c = Courtyard::Get();
-  Sampler sampler(c.bake, c.Capture(), *c.caster);
-  sampler.SetSun(c.sun);
-  const std::vector<Sample> samples = sampler.Draw(c.linear, c.exposure);
-  const SunSkyFitSummary fit = FitSunSky({}, samples);
+  const FittedFrame f = FitCourtyardFrame(c);
   for (auto _ : state) {
-    const SkyShapeSpread shape = SkyShapeSpreadOfFit({}, {}, samples, fit, c.bake.camera.surface);
+    const SkyShapeSpread shape = SkyShapeSpreadOfFit({}, {}, f.samples, f.fit, c.bake.camera.surface);
     benchmark::DoNotOptimize(shape.sky.x);
   }
 }
