@@ -310,6 +310,12 @@ void ReportBursts(const std::vector<BurstLighting>& bursts, const std::filesyste
                               "the sunlit samples alone (fit confidence 0): the estimate holds the last fit that had both",
                               b.burst.index, b.frames_without_shadowed, frames));
     }
+    if (b.frames_sun_not_observed > 0) {
+      report->Say(fmt::format("  burst {}: E_sun not observed in {} of {} frames: the sun below the horizon, or too weak "
+                              "a part of the sunlit samples' light (behind cloud) to be told from the sky; its interval "
+                              "there runs from 0 to 11 times the value, which says nothing",
+                              b.burst.index, b.frames_sun_not_observed, frames));
+    }
   }
   report->Figure("lighting/bursts", static_cast<double>(bursts.size()));
 }

@@ -243,6 +243,9 @@ TEST(CliTest, EstimateWritesTheStableCsv) {
   // One frame, which moved the sun: no per-frame timing, said in words, not "nan ms" (issue 43).
   EXPECT_EQ(run.err.find("nan"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("not timed"), std::string::npos) << run.err;
+  // The sun is down: the report says which quantity is not observed, where and why.
+  EXPECT_NE(run.out.find("burst 0: E_sun not observed in 1 of 1 frames: the sun below the horizon"), std::string::npos)
+      << run.out;
   EXPECT_EQ(ReadCsvFile(rec.dir / "est_bursts.csv").rows.size(), 1u);  // the per-burst table, no truth
   const CsvTable table = ReadCsvFile(out);
   EXPECT_EQ(table.header, (std::vector<std::string>{"frame", "time_utc", "sun_elevation_deg", "sun_azimuth_deg", "sun_r",
