@@ -4,9 +4,16 @@
 # recordings against the path tracer, which the plain pass runs; under the sanitizers they cost
 # most of CI's time and reach no code the other tests do not) and `browser` (the viewer in
 # Chromium: its JavaScript gains nothing from them; the server's C++ is tested under them by
-# serve/lighting_server_test).
+# serve/lighting_server_test). --loaded: the same beside a CPU hog on every core (stress-ng), as
+# on a user's busy laptop: no test may need an idle machine (issue 41).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+loaded=0
+args=()
+for arg in "$@"; do
+  if [ "$arg" = "--loaded" ]; then loaded=1; else args+=("$arg"); fi
+done
+set -- "${args[@]}"
 build_dir=$(bash scripts/build.sh "$@" | tail -n 1)
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
@@ -29,4 +36,9 @@ if [ "${1:-}" = "--sanitize" ]; then
   done
 fi
 cd "$build_dir"
+if [ "$loaded" -eq 1 ]; then
+  stress-ng --cpu "$(nproc)" --timeout 7200 >/dev/null 2>&1 &
+  hog=$!
+  trap 'kill "$hog" 2>/dev/null || true' EXIT
+fi
 ctest -j "$(nproc)" --output-on-failure --timeout 600 "${filter[@]}"
