@@ -46,8 +46,10 @@ render() {
     work=$out/$name/work
     mkdir -p "$work"
     echo "scenes: rendering $name ($(date +%T))" >&2
-    [[ -s $work/bursts.json ]] || "$py" "$gen/sunpos_bursts.py" "$cfg" >"$work/bursts.json.tmp"
-    [[ -s $work/bursts.json ]] || mv "$work/bursts.json.tmp" "$work/bursts.json"
+    if [[ ! -s $work/bursts.json ]]; then
+      "$py" "$gen/sunpos_bursts.py" "$cfg" >"$work/bursts.json.tmp"
+      mv "$work/bursts.json.tmp" "$work/bursts.json"
+    fi
     if grep -q '"probe_sky"' "$cfg"; then "$py" "$gen/probe_sky.py" "$cfg" "$work" >/dev/null; fi
     nice -n 19 blender -b --factory-startup --python "$gen/render_bases.py" -- \
       --config "$cfg" --bursts "$work/bursts.json" --work "$work" >"$work/render.log" 2>&1 ||
@@ -74,6 +76,15 @@ recordings_of() {
   fi
 }
 
+# A recording's name in the table and in build/scenes/{cache,estimates,figures}: its folder's, or
+# for a rendered one (build/scenes/NAME/recording) its scene's.
+name_of() {
+  local name
+  name=$(basename "$1")
+  [[ $name == recording ]] && name=$(basename "$(dirname "$1")")
+  echo "$name"
+}
+
 measure() {
   local recordings name rec
   recordings_of "$@"
@@ -81,7 +92,7 @@ measure() {
   mkdir -p "$out/figures" "$out/estimates"
   for rec in "${recordings[@]}"; do
     [[ -f $rec/scene.json ]] || { echo "scenes.sh: no recording at $rec (render it first)" >&2; exit 2; }
-    name=$(basename "$rec"); [[ $name == recording ]] && name=$(basename "$(dirname "$rec")")
+    name=$(name_of "$rec")
     echo "scenes: estimating $name" >&2
     build/bin/daylit -q estimate "$rec" --cache "$out/cache/$name" --out "$out/estimates/$name.csv" \
       --figures "$out/figures/$name.json" >/dev/null
@@ -90,17 +101,17 @@ measure() {
 }
 
 table() {
-  local recordings
+  local recordings rec names=()
   recordings_of "$@"
+  for rec in "${recordings[@]}"; do names+=("$(name_of "$rec")"); done
   # One row per scene: the worst burst (median over the burst, per channel), the p90 of the frames'
   # worst channel, the frames beyond 10%, and the 90% interval: bursts it holds, median half-widths.
-  "$py" - "$out/figures" "${recordings[@]}" <<'EOF'
+  "$py" - "$out/figures" "${names[@]}" <<'EOF'
 import json, os, sys
 figs = sys.argv[1]
 print("| scene | worst burst | p90 | frames > 10% | interval holds | half-width E_sun / E_sky |")
 print("| --- | --- | --- | --- | --- | --- |")
-for rec in sys.argv[2:]:
-    name = os.path.basename(rec) if os.path.basename(rec) != "recording" else os.path.basename(os.path.dirname(rec))
+for name in sys.argv[2:]:
     f = json.load(open(os.path.join(figs, name + ".json")))
     worst, where = 0.0, ""
     for k in range(int(f["lighting/bursts"])):
