@@ -219,12 +219,23 @@ struct GltfFiles {
     if (refused.empty()) refused = file;
     return false;
   }
+  // Only a regular file: tinygltf sizes a file by seeking to its end, and a folder on ext4 seeks
+  // to 2^63 - 1 (a uri "" or "." names the glTF's own folder), a request for that many bytes.
+  static bool IsFile(const std::string& file) {
+    std::error_code error;
+    return std::filesystem::is_regular_file(file, error);
+  }
   static bool Exists(const std::string& file, void* self) {
-    return static_cast<GltfFiles*>(self)->Allows(file) && tinygltf::FileExists(file, nullptr);
+    return static_cast<GltfFiles*>(self)->Allows(file) && IsFile(file);
   }
   static std::string Expand(const std::string& file, void*) { return file; }
   static bool Read(std::vector<unsigned char>* out, std::string* err, const std::string& file, void* self) {
-    return static_cast<GltfFiles*>(self)->Allows(file) && tinygltf::ReadWholeFile(out, err, file, nullptr);
+    if (!static_cast<GltfFiles*>(self)->Allows(file)) return false;
+    if (!IsFile(file)) {
+      if (err != nullptr) *err += "'" + file + "' is not a file\n";
+      return false;
+    }
+    return tinygltf::ReadWholeFile(out, err, file, nullptr);
   }
   static bool Write(std::string*, const std::string&, const std::vector<unsigned char>&, void*) { return false; }
 };

@@ -198,6 +198,16 @@ TEST(ObjectMeshTest, GltfBuffersOutsideTheRecordingAreRefused) {
     EXPECT_NE(std::string(e.what()).find("outside the recording folder"), std::string::npos) << e.what();
   }
   EXPECT_EQ(ObjectMesh(gltf("linked_inside.gltf", "good.bin")).indices.size(), 3u);
+  // A uri that names a folder (the glTF's own, or one beside it): an input error, with or without
+  // a root, not a request for the 2^63 - 1 bytes a folder seeks to on ext4 (fuzz_gltf found it).
+  fs::create_directories(dir / "rec" / "objects" / "sub");
+  for (const std::string uri : {"", ".", "sub", "../objects/"}) {
+    for (const bool rooted : {true, false}) {
+      VirtualObject object = gltf("folder.gltf", uri);
+      if (!rooted) object.resource_root.clear();
+      EXPECT_THROW(ObjectMesh(object), InputError) << "uri '" << uri << "'";
+    }
+  }
   fs::remove_all(dir);
 }
 
