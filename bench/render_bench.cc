@@ -10,6 +10,7 @@
 #include "bake/bake.h"
 #include "base/log.h"
 #include "estimation/frame_estimator.h"
+#include "pipeline/frame_fits.h"
 #include "render/compositor.h"
 #include "render/frame_renderer.h"
 #include "render/gl_context.h"
@@ -29,7 +30,7 @@ struct Courtyard {
   scene::Scene scene = scene::LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a");
   bake::SceneBake bake;
   std::unique_ptr<scene::RayCaster> caster;
-  estimation::FrameFit fit;
+  pipeline::FrameFit fit;
 
   Courtyard() {
     SetLogVerbosity(0);
@@ -39,7 +40,7 @@ struct Courtyard {
     bool loaded = false;
     bake = bake::BakeOrLoad(scene, bake::BakeOptions{}, DAYLIT_BINARY_DIR "/bench-cache/courtyard-a", &loaded);
     caster = std::make_unique<scene::RayCaster>(scene.model);
-    fit = estimation::FitFrame(scene, bake, *caster, 300, {});
+    fit = pipeline::FitRecordingFrame(scene, bake, *caster, 300);
   }
   static Courtyard& Get() {
     static Courtyard c;

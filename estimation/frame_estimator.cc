@@ -121,42 +121,6 @@ FrameLight FrameEstimator::Hold(const capture::Frame& frame, const scene::Tracke
   return out;
 }
 
-FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster, size_t position,
-                  const FrameEstimatorOptions& options) {
-  if (!scene.frame_times) ThrowInputError("{}: frames: a live device has no recorded frames", scene.file.string());
-  const std::vector<capture::FrameTime>& times = scene.frame_times->frames;
-  if (position >= times.size()) {
-    ThrowInputError("{}: frame {} is past the recording's {} frames", scene.file.string(), position, times.size());
-  }
-  std::unique_ptr<capture::FrameSource> source = scene::OpenFrameSource(scene);
-  source->Seek(times[position].index);
-  capture::Frame frame;
-  if (source->Next(&frame) != capture::FrameStatus::kFrame) {
-    ThrowInputError("{}: frame {} cannot be decoded", scene.file.string(), times[position].index);
-  }
-  return FitDecodedFrame(scene, bake, caster, std::move(frame), options);
-}
-
-FrameFit FitDecodedFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
-                         capture::Frame frame, const FrameEstimatorOptions& options) {
-  if (frame.rgb.cols != bake.camera.width || frame.rgb.rows != bake.camera.height) {
-    ThrowInputError("{}: frame {} is {}x{}, not the camera's {}x{}", scene.file.string(), frame.index, frame.rgb.cols,
-                    frame.rgb.rows, bake.camera.width, bake.camera.height);
-  }
-  scene::SunTracker tracker(scene);
-  const scene::TrackedSun& sun = tracker.Update(frame.utc);
-  FrameEstimator estimator(scene, bake, caster, options);
-  const FrameLight light = estimator.Estimate(frame, sun);
-  FrameFit out;
-  out.row = light.row;
-  out.row.light = light.fit.light;  // the fit's own, not the filter's
-  out.row.confidence = light.fit.confidence;
-  out.fit = light.fit;
-  out.sun_dir = sun.dir_in_scene;
-  out.frame = std::move(frame);
-  return out;
-}
-
 std::string EstimatesCsv(const std::vector<FrameEstimate>& frames) {
   fmt::memory_buffer out;
   fmt::format_to(std::back_inserter(out), "frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,"

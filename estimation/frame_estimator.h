@@ -95,21 +95,6 @@ class FrameEstimator {
   SunColourMemory sun_colour_;
 };
 
-// The unfiltered fit of one frame (its position in frames.csv), as the estimator makes it:
-// decodes the recording up to it. Throws InputError if the position is out of range or the frame
-// cannot be decoded. `caster`: the scene's model.
-struct FrameFit {
-  FrameEstimate row;        // light and confidence: the fit's own
-  SunSkyFitSummary fit;
-  glm::vec3 sun_dir{0.0f};  // unit, scene coordinates
-  capture::Frame frame;     // the frame it was fitted to
-};
-FrameFit FitFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster, size_t position,
-                  const FrameEstimatorOptions& options);
-// The same for a frame already read.
-FrameFit FitDecodedFrame(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
-                         capture::Frame frame, const FrameEstimatorOptions& options);
-
 // The stable CSV: frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,sky_g,
 // sky_b,confidence,samples.
 std::string EstimatesCsv(const std::vector<FrameEstimate>& frames);

@@ -1,4 +1,4 @@
-// One frame of the augmented video, from a fitted frame (estimation::FitFrame or the replay's
+// One frame of the augmented video, from a fitted frame (pipeline::FitRecordingFrame or the replay's
 // estimate) to the composite in linear radiance units: the frame linearised with the camera
 // response and its exposure divided out, the objects' shadows and sky loss applied to the real
 // surfaces (composite::ObjectShadows) less what the objects reflect onto them

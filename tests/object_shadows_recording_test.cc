@@ -15,6 +15,7 @@
 
 #include "base/csv.h"
 #include "estimation/frame_estimator.h"
+#include "pipeline/frame_fits.h"
 #include "relight/env_relight.h"
 #include "scene/hdr_image.h"
 #include "scene/object_mesh.h"
@@ -57,13 +58,18 @@ TEST(ObjectShadowsRecordingTest, ShadowsAndSkyLossMatchThePathTracer) {
   const sunmodel::Atmosphere atmosphere = sunmodel::Atmosphere::Standard(scene.location.elevation_m);
   double worst = 0.0;
   int frames = 0;
+  std::vector<size_t> positions;
   for (size_t position = 0; position < scene.frame_times->frames.size(); ++position) {
     const int index = scene.frame_times->frames[position].index;
-    const UtcTime time = scene.frame_times->frames[position].utc;
+    if (fs::is_regular_file(gt / "with_objects" / fmt::format("{:06d}.exr", index))) positions.push_back(position);
+  }
+  // The truth's E_sun and E_sky; the clouds' share (not in groundtruth.csv) from the fit.
+  const std::vector<pipeline::FrameFit> fits = pipeline::FitRecordingFrames(scene, c.bake, real, positions);
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const int index = scene.frame_times->frames[positions[i]].index;
+    const UtcTime time = scene.frame_times->frames[positions[i]].utc;
     const fs::path with_file = gt / "with_objects" / fmt::format("{:06d}.exr", index);
-    if (!fs::is_regular_file(with_file)) continue;
-    // The truth's E_sun and E_sky; the clouds' share (not in groundtruth.csv) from the fit.
-    const double overcast = estimation::FitFrame(scene, c.bake, real, position, {}).fit.overcast_share;
+    const double overcast = fits[i].fit.overcast_share;
     const HdrImage with = scene::ReadHdrImage(with_file);
     HdrImage predicted = scene::ReadHdrImage(gt / "without_objects" / fmt::format("{:06d}.exr", index));
     const HdrImage without = predicted;

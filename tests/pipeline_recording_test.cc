@@ -5,10 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdio>
 #include <vector>
 
+#include "base/error.h"
+#include "pipeline/frame_fits.h"
 #include "pipeline/lighting_pipeline.h"
 #include "scene/raycaster.h"
+#include "scene/sun_tracker.h"
 #include "tests/courtyard_fixture.h"
 
 namespace daylit::pipeline {
@@ -104,6 +108,46 @@ TEST(PipelineRecordingTest, ASinksStopOrTheStopFlagEndsTheRunAfterTheFrameAtHand
   options.stop = &stop;
   LightingPipeline stopped(c.scene, c.bake, caster, options);
   EXPECT_TRUE(stopped.Run(scene::OpenFrameSource(c.scene)).frames.empty());
+}
+
+// The frames one command shows (render, relight --frame, relight-env) are fitted as estimate fits
+// them: their rows are estimate's rows (the interval, the sun), and a frame of the overcast burst
+// (11:36, E_sun a third of E_sky) carries the sun colour the bursts before it measured, where a
+// frame fitted alone has only the capture's.
+TEST(PipelineRecordingTest, AFrameFittedForOneCommandIsFittedAsEstimateFitsIt) {
+  const testing::BundledCourtyard& c = testing::Courtyard();
+  const scene::RayCaster caster(c.scene.model);
+  const std::vector<size_t> positions = {330, 310, 330};
+  const std::vector<FrameFit> fits = FitRecordingFrames(c.scene, c.bake, caster, positions);
+  ASSERT_EQ(fits.size(), 3u);
+  LightingPipelineOptions options;
+  options.max_frames = 331;
+  const PipelineRun run = LightingPipeline(c.scene, c.bake, caster, options).Run(scene::OpenFrameSource(c.scene));
+  ASSERT_EQ(run.frames.size(), 331u);
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const estimation::FrameEstimate& row = run.frames[positions[i]];
+    const FrameFit& fit = fits[i];
+    EXPECT_EQ(fit.row.frame, row.frame);
+    EXPECT_EQ(fit.frame.index, row.frame);
+    EXPECT_FALSE(fit.frame.rgb.empty());
+    EXPECT_DOUBLE_EQ(fit.row.sun_elevation_deg, row.sun_elevation_deg);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_DOUBLE_EQ(fit.row.interval.sun[k], row.interval.sun[k]) << row.frame;
+      EXPECT_DOUBLE_EQ(fit.row.interval.sky[k], row.interval.sky[k]) << row.frame;
+    }
+    EXPECT_EQ(fit.row.light.sun_rgb, fit.fit.light.sun_rgb) << "the fit's own light, not the filter's";
+    // Alone: one estimator that has seen nothing before this frame.
+    scene::SunTracker tracker(c.scene);
+    estimation::FrameEstimator alone(c.scene, c.bake, caster, {});
+    const estimation::FrameLight lone = alone.Estimate(fit.frame, tracker.Update(fit.frame.utc));
+    std::printf("frame %d: carried sun colour weight %.2f after the bursts before it, %.2f alone; E_sun R G B %+.1f%% "
+                "%+.1f%% %+.1f%% from alone\n", row.frame, fit.fit.carried_weight, lone.fit.carried_weight,
+                100 * (fit.fit.light.sun_rgb.x / lone.fit.light.sun_rgb.x - 1), 100 * (fit.fit.light.sun_rgb.y / lone.fit.light.sun_rgb.y - 1),
+                100 * (fit.fit.light.sun_rgb.z / lone.fit.light.sun_rgb.z - 1));
+    EXPECT_GT(fit.fit.carried_weight, 2.0 * lone.fit.carried_weight) << row.frame;
+  }
+  EXPECT_EQ(fits[0].fit.light.sun_rgb, fits[2].fit.light.sun_rgb);
+  EXPECT_THROW(FitRecordingFrames(c.scene, c.bake, caster, {c.scene.frame_times->frames.size()}), InputError);
 }
 
 TEST(PipelineRecordingTest, OptionsAreCheckedBeforeAnyWork) {

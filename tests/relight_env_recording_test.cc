@@ -15,6 +15,7 @@
 #include "tests/courtyard_fixture.h"
 #include "base/log.h"
 #include "estimation/frame_estimator.h"
+#include "pipeline/frame_fits.h"
 #include "relight/env_relight.h"
 #include "scene/scene.h"
 
@@ -27,8 +28,11 @@ TEST(RelightEnvRecordingTest, RelitMapsMatchThePathTracedOnes) {
   const scene::RayCaster caster(scene.model);
   relight::EnvRelighter relighter(baked, glm::vec3(scene.envmap->position), caster);
   double worst_surface = 0.0, worst_sky = 0.0;
-  for (const int frame : {300, 347, 550, 598}) {
-    const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, static_cast<size_t>(frame), {});
+  const std::vector<size_t> frames = {300, 347, 550, 598};
+  const std::vector<pipeline::FrameFit> fits = pipeline::FitRecordingFrames(scene, baked, caster, frames);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const int frame = static_cast<int>(frames[i]);
+    const pipeline::FrameFit& fit = fits[i];
     relighter.SetSun(fit.sun_dir);
     std::vector<glm::vec3> radiance;
     relighter.Relight(fit.fit.light, fit.fit.overcast_share, &radiance);

@@ -13,6 +13,7 @@
 #include "bake/bake.h"
 #include "capture/frame_source.h"
 #include "estimation/frame_estimator.h"
+#include "pipeline/frame_fits.h"
 #include "relight/image_relight.h"
 #include "scene/scene.h"
 #include "tests/courtyard_fixture.h"
@@ -21,14 +22,14 @@ namespace daylit {
 namespace {
 
 struct Fitted {
-  estimation::FrameFit fit;
+  pipeline::FrameFit fit;
   std::vector<float> linear;
   estimation::LightParts parts;
 };
 
 Fitted Fit(const scene::RayCaster& caster, int frame) {
   const scene::Scene& scene = testing::Courtyard().scene;
-  Fitted f{estimation::FitFrame(scene, testing::Courtyard().bake, caster, static_cast<size_t>(frame), {}), {}, {}};
+  Fitted f{pipeline::FitRecordingFrame(scene, testing::Courtyard().bake, caster, static_cast<size_t>(frame)), {}, {}};
   EXPECT_TRUE(f.fit.fit.IsUsable()) << frame;
   capture::LinearRadiance(f.fit.frame, capture::Linearizer(scene.response), &f.linear);
   f.parts = estimation::SplitLight(f.fit.fit.light, f.fit.fit.overcast_share);

@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "evaluation/composite_truth.h"
+#include "pipeline/frame_fits.h"
 #include "render/gl_context.h"
 #include "tests/courtyard_fixture.h"
 
@@ -23,18 +24,27 @@ struct Fidelity {
   int frames = 0;
 };
 
-// Over a recording's truth frames, each fitted on its own, the composite with `options`.
+// Over a recording's truth frames, each fitted as estimate fits it (pipeline/frame_fits.h), the
+// composite with `options`.
 Fidelity Composite(const testing::BundledCourtyard& c, const FrameRendererOptions& options, const char* what) {
   const scene::Scene& scene = c.scene;
   const scene::RayCaster caster(scene.model);
   FrameRenderer renderer(scene, c.bake, caster, options);
   Fidelity r;
   std::vector<float> out, linear;
+  std::vector<size_t> positions;
+  std::vector<evaluation::TruthFrame> truths;
   for (size_t position = 0; position < scene.frame_times->frames.size(); ++position) {
-    const int index = scene.frame_times->frames[position].index;
-    const std::optional<evaluation::TruthFrame> truth = evaluation::ReadTruthFrame(scene, index);
+    std::optional<evaluation::TruthFrame> truth = evaluation::ReadTruthFrame(scene, scene.frame_times->frames[position].index);
     if (!truth) continue;
-    const estimation::FrameFit fit = estimation::FitFrame(scene, c.bake, caster, position, {});
+    positions.push_back(position);
+    truths.push_back(std::move(*truth));
+  }
+  const std::vector<pipeline::FrameFit> fits = pipeline::FitRecordingFrames(scene, c.bake, caster, positions);
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const int index = scene.frame_times->frames[positions[i]].index;
+    const evaluation::TruthFrame* truth = &truths[i];
+    const pipeline::FrameFit& fit = fits[i];
     renderer.Linearize(fit.frame, &linear);
     renderer.Render(fit.frame, fit.fit.light, fit.fit.overcast_share, fit.sun_dir, &out);
     const evaluation::CompositeFidelity f = evaluation::CompareComposite(out, linear, truth->with, truth->without, truth->mask);

@@ -17,6 +17,7 @@
 #include "bake/sampling.h"
 #include "base/log.h"
 #include "estimation/frame_estimator.h"
+#include "pipeline/frame_fits.h"
 #include "relight/env_relight.h"
 #include "sh/irradiance_volume.h"
 #include "base/latlong.h"
@@ -29,7 +30,7 @@ TEST(VolumeRecordingTest, CourtyardVolumeMatchesBruteForceIrradiance) {
   const scene::Scene& scene = testing::Courtyard().scene;
   const bake::SceneBake& baked = testing::Courtyard().bake;
   const scene::RayCaster caster(scene.model);
-  const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, 550, {});
+  const pipeline::FrameFit fit = pipeline::FitRecordingFrame(scene, baked, caster, 550);
   relight::EnvRelighter relighter(baked, glm::vec3(scene.envmap->position), caster);
   relighter.SetSun(fit.sun_dir);
   std::vector<glm::vec3> env;  // the relit map stacked on its sky layer (bake/parallax.h)

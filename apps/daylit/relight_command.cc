@@ -18,6 +18,7 @@
 #include "capture/response.h"
 #include "estimation/frame_estimator.h"
 #include "evaluation/composite_truth.h"
+#include "pipeline/frame_fits.h"
 #include "pipeline/lighting_pipeline.h"
 #include "pipeline/stages.h"
 #include "pipeline/video_output.h"
@@ -71,8 +72,8 @@ fs::path StripPath(const fs::path& out) {
 }
 
 void CompareWithRealFrame(const scene::Scene& scene, const bake::SceneBake& baked, const relight::ImageRelighter& relighter,
-                          const relight::RelightTarget& target, const estimation::FrameFit& original, const std::vector<float>& relit,
-                          const estimation::FrameFit& real, const fs::path& out) {
+                          const relight::RelightTarget& target, const pipeline::FrameFit& original, const std::vector<float>& relit,
+                          const pipeline::FrameFit& real, const fs::path& out) {
   const capture::Linearizer linearizer(scene.response);
   std::vector<float> before, after;
   capture::LinearRadiance(original.frame, linearizer, &before);
@@ -168,7 +169,7 @@ relight::RelightTarget TargetFromOptions(const RelightOptions& o, const scene::S
 }
 
 // --like-frame: that frame's own fit becomes the new sun and light.
-void LikeFrame(const estimation::FrameFit& like, relight::RelightTarget* target) {
+void LikeFrame(const pipeline::FrameFit& like, relight::RelightTarget* target) {
   if (!like.fit.IsUsable()) ThrowInputError("--like-frame: frame {} has no estimate ({})", like.row.frame, like.fit.message);
   target->sun_dir_in_scene = like.sun_dir;
   target->sun_elevation_deg = like.row.sun_elevation_deg;
@@ -181,10 +182,8 @@ void LikeFrame(const estimation::FrameFit& like, relight::RelightTarget* target)
 
 // --frame N: that frame under its own fit, relit, as PNG or EXR (with --like-frame, compared).
 void RelightOneFrame(const RelightOptions& o, const scene::Scene& scene, const bake::SceneBake& baked,
-                     const scene::RayCaster& caster, size_t position, const std::optional<estimation::FrameFit>& like,
-                     pipeline::RelightStage* stage) {
+                     const pipeline::FrameFit& fit, const std::optional<pipeline::FrameFit>& like, pipeline::RelightStage* stage) {
   const fs::path out(o.out);
-  const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, position, {});
   if (!fit.fit.IsUsable()) ThrowInputError("frame {}: no estimate ({}); it cannot be relit", *o.frame, fit.fit.message);
   std::vector<float> image;
   stage->Relight(fit.frame, fit.fit.light, fit.fit.overcast_share, fit.sun_dir, fit.row.sun_elevation_deg, &image);
@@ -243,9 +242,14 @@ void RunRelight(const RelightOptions& o) {
   bool loaded = false;
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, bake::CacheDir(scene, o.cache), &loaded);
   const scene::RayCaster caster(scene.model);
-  std::optional<estimation::FrameFit> like;
+  // The frame to relight and the one whose light it takes, fitted in one read of the recording.
+  std::vector<size_t> positions;
+  if (o.frame) positions.push_back(position);
+  if (o.like_frame) positions.push_back(like_position);
+  std::vector<pipeline::FrameFit> fits = pipeline::FitRecordingFrames(scene, baked, caster, positions);
+  std::optional<pipeline::FrameFit> like;
   if (o.like_frame) {
-    like = estimation::FitFrame(scene, baked, caster, like_position, {});
+    like = std::move(fits.back());
     LikeFrame(*like, &target);
   }
   if (target.sun_dir_in_scene.z <= 0.0f) {
@@ -259,7 +263,7 @@ void RunRelight(const RelightOptions& o) {
   pipeline::RelightStage stage(scene, baked, caster, target, options, renderer.get());
   Log().info("relighting to {}{}", target.what, o.gpu ? ", on the GPU path" : "");
   if (o.frame) {
-    RelightOneFrame(o, scene, baked, caster, position, like, &stage);
+    RelightOneFrame(o, scene, baked, fits.front(), like, &stage);
   } else {
     RelightVideo(o, scene, baked, caster, range, &*video, &stage);
   }

@@ -11,6 +11,7 @@
 #include "base/error.h"
 #include "base/log.h"
 #include "estimation/frame_estimator.h"
+#include "pipeline/frame_fits.h"
 #include "relight/env_relight.h"
 #include "scene/scene.h"
 
@@ -41,7 +42,7 @@ void RunRelightEnv(const RelightEnvOptions& o) {
   bool loaded = false;
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, bake::CacheDir(scene, o.cache), &loaded);
   const scene::RayCaster caster(scene.model);
-  const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, position, {});
+  const pipeline::FrameFit fit = pipeline::FitRecordingFrame(scene, baked, caster, position);
   Log().info("frame {}: E_sun ({:.3g}, {:.3g}, {:.3g}), E_sky ({:.3g}, {:.3g}, {:.3g}), overcast share {:.2f}, "
              "confidence {:.2f}",
              o.frame, fit.fit.light.sun_rgb.x, fit.fit.light.sun_rgb.y, fit.fit.light.sun_rgb.z, fit.fit.light.sky_rgb.x,

@@ -13,6 +13,7 @@
 #include "capture/response.h"
 #include "estimation/frame_estimator.h"
 #include "evaluation/composite_truth.h"
+#include "pipeline/frame_fits.h"
 #include "render/frame_renderer.h"
 #include "render/gl_context.h"
 #include "report/plot.h"
@@ -56,7 +57,7 @@ void RunRender(const RenderOptions& o) {
   bool loaded = false;
   const bake::SceneBake baked = bake::BakeOrLoad(scene, bake::BakeOptions{}, bake::CacheDir(scene, o.cache), &loaded);
   const scene::RayCaster caster(scene.model);
-  const estimation::FrameFit fit = estimation::FitFrame(scene, baked, caster, position, {});
+  const pipeline::FrameFit fit = pipeline::FitRecordingFrame(scene, baked, caster, position);
   render::FrameRenderer renderer(scene, baked, caster, options);
   std::vector<float> composite;
   renderer.Render(fit.frame, fit.fit.light, fit.fit.overcast_share, fit.sun_dir, &composite);
