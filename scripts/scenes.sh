@@ -39,6 +39,33 @@ render() {
   cp "$recgen"/*.py "$out/recgen/"
   sed -i 's/cfg\["sky"\]\["\(air_density\|dust_density\|ozone_density\)"\]/cfg.get("sky", {}).get("\1", float("nan"))/g' \
     "$out/recgen/readme_text.py"
+  # A second: compose.py describes principled materials only beside the render-only detail (its
+  # window glass), and fails on a scene with the one and not the other (gen-b-photo); such a
+  # scene's materials are described without it.
+  "$py" - "$out/recgen/compose.py" <<'EOF'
+import sys
+path = sys.argv[1]
+text = open(path).read()
+wrapper = """
+_materials_info_with_detail = materials_info
+
+
+def materials_info(cfg):
+    if "detail" in cfg:
+        return _materials_info_with_detail(cfg)
+    (r0, r1), (s0, s1) = material_ranges(cfg)
+    per = {s_["name"]: {"roughness": s_["mat"].get("roughness", cfg["materials"]["default_roughness"]),
+                        "specular": s_["mat"].get("specular", cfg["materials"]["specular"])} for s_ in cfg["surfaces"]}
+    return {"bsdf": "Principled BSDF (Blender 3.4, GGX, Disney diffuse) on every real surface: base colour = the "
+                    "procedural albedo texture, specular %g-%g, roughness %g-%g; no render-only detail" % (s0, s1, r0, r1),
+            "per_material": per, "glossy_bounces": cfg["render"].get("glossy_bounces", 0), "reflective_caustics": False,
+            "albedo_truth": "the Diffuse Color pass, rendered once with 0 bounces"}
+
+
+if __name__ == "__main__":"""
+text = text.replace('\nif __name__ == "__main__":', wrapper, 1)
+open(path, "w").write(text)
+EOF
   local gen=$out/recgen name cfg work
   for name in $(scene_names "$@"); do
     cfg=$root/scenes/$name.json
