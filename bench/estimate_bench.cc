@@ -110,15 +110,19 @@ void BM_EstimateFrame(benchmark::State& state) {
   double t = 0.0;
   const LightIntervalOptions interval_options;
   SkyShapeSpread shape;
+  StrataSensitivity sensitivity;
   long frame = 0;
   for (auto _ : state) {
     const std::vector<Sample> samples = sampler.Draw(c.linear, c.exposure);
     const SunSkyFitSummary fit = FitSunSky({}, samples);
-    // The sky shape's refits every two seconds, as the estimator makes them: every twentieth frame at 10 fps.
+    // The sky shape's and the strata sensitivity's refits every two seconds, as the estimator makes
+    // them: every twentieth frame at 10 fps.
     if (frame++ % 20 == 0) {
       shape = SkyShapeSpreadOfFit(interval_options, {}, samples, fit, c.bake.camera.surface);
+      sensitivity = StrataSensitivityOfFit(interval_options, {}, samples, fit);
     }
-    const LightInterval interval = IntervalOfFit(interval_options, {}, samples, fit, c.bake.camera.surface, shape);
+    const LightInterval interval =
+        IntervalOfFit(interval_options, {}, samples, fit, c.bake.camera.surface, shape, sensitivity);
     const FilteredLight light = filter.Update(t += 0.1, fit.light, fit.confidence);
     benchmark::DoNotOptimize(light.light.sun_rgb.x);
     benchmark::DoNotOptimize(interval.sky.x);
@@ -136,6 +140,18 @@ void BM_SkyShapeSpread(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_SkyShapeSpread)->Unit(benchmark::kMillisecond);
+
+// The strata sensitivity's two refits of one frame (estimation/light_interval.h), made with the sky
+// shape's.
+void BM_StrataSensitivity(benchmark::State& state) {
+  Courtyard& c = Courtyard::Get();
+  const FittedFrame f = FitCourtyardFrame(c);
+  for (auto _ : state) {
+    const StrataSensitivity sensitivity = StrataSensitivityOfFit({}, {}, f.samples, f.fit);
+    benchmark::DoNotOptimize(sensitivity.sky.x);
+  }
+}
+BENCHMARK(BM_StrataSensitivity)->Unit(benchmark::kMillisecond);
 
 // A sun move: shadow rays for every model pixel, new strata, transfer terms of the pools (paths
 // already traced: the first move traces them, which is timed apart).

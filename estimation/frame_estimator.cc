@@ -90,12 +90,17 @@ FrameLight FrameEstimator::Estimate(const capture::Frame& frame, const scene::Tr
       filter_.Update(t_s, out.fit.IsUsable() ? std::optional<SunSky>(out.fit.light) : std::nullopt, out.fit.confidence);
   if (out.fit.IsUsable()) {
     overcast_share_ = out.fit.overcast_share;
-    if (options_.interval.sky_shape &&
-        (!sky_shape_at_s_ || t_s < *sky_shape_at_s_ || t_s - *sky_shape_at_s_ >= options_.interval.sky_shape_every_s)) {
-      sky_shape_ = SkyShapeSpreadOfFit(options_.interval, options_.fit, out.samples, out.fit, bake_.camera.surface);
-      sky_shape_at_s_ = t_s;
+    if (!refits_at_s_ || t_s < *refits_at_s_ || t_s - *refits_at_s_ >= options_.interval.sky_shape_every_s) {
+      if (options_.interval.sky_shape) {
+        sky_shape_ = SkyShapeSpreadOfFit(options_.interval, options_.fit, out.samples, out.fit, bake_.camera.surface);
+      }
+      if (options_.interval.strata_sensitivity) {
+        sensitivity_ = StrataSensitivityOfFit(options_.interval, options_.fit, out.samples, out.fit);
+      }
+      refits_at_s_ = t_s;
     }
-    interval_ = IntervalOfFit(options_.interval, options_.fit, out.samples, out.fit, bake_.camera.surface, sky_shape_);
+    interval_ = IntervalOfFit(options_.interval, options_.fit, out.samples, out.fit, bake_.camera.surface, sky_shape_,
+                              sensitivity_);
   }
   out.overcast_share = overcast_share_;
   out.row.interval = interval_;

@@ -90,8 +90,11 @@ class FrameEstimator {
   std::optional<UtcTime> first_utc_;
   double overcast_share_ = 0.0;
   LightInterval interval_;  // the last usable fit's
-  SkyShapeSpread sky_shape_;              // the last one made (LightIntervalOptions::sky_shape_every_s)
-  std::optional<double> sky_shape_at_s_;  // when, in seconds since the first frame
+  // The last sky shape's spread and strata sensitivity made (LightIntervalOptions::sky_shape_every_s),
+  // and when, in seconds since the first frame.
+  SkyShapeSpread sky_shape_;
+  StrataSensitivity sensitivity_;
+  std::optional<double> refits_at_s_;
   SunColourMemory sun_colour_;
 };
 

@@ -140,9 +140,40 @@ SkyShapeSpread SkyShapeSpreadOfFit(const LightIntervalOptions& options, const Su
   return out;
 }
 
+StrataSensitivity StrataSensitivityOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
+                                         const std::vector<Sample>& samples, const SunSkyFitSummary& fit) {
+  StrataSensitivity out;
+  if (!fit.IsUsable() || fit.sunlit_samples == 0) return out;
+  // A bias the size of the floor: small beside the Cauchy scale (0.1), so the reweighting barely
+  // changes and the response is the fit's linear one.
+  constexpr double kBias = 0.02;
+  SunSkyFitOptions refit_options = fit_options;
+  refit_options.iterations = std::min(fit_options.iterations, options.sky_shape_iterations);
+  // Every second sample: the sensitivity is the transfer terms', not the pixels' noise, and half
+  // the samples halve the refits' cost.
+  std::vector<Sample> half;
+  half.reserve(samples.size() / 2 + 1);
+  for (size_t i = 0; i < samples.size(); i += 2) half.push_back(samples[i]);
+  const SunSkyFitSummary base = FitSunSky(refit_options, half);
+  std::vector<Sample> biased = std::move(half);
+  for (Sample& s : biased) {
+    if (!s.sunlit) s.radiance *= static_cast<float>(1.0 + kBias);
+  }
+  const SunSkyFitSummary moved = FitSunSky(refit_options, biased);
+  if (!base.IsUsable() || !moved.IsUsable()) return out;
+  for (int c = 0; c < 3; ++c) {
+    const double sun = base.light.sun_rgb[c], sky = base.light.sky_rgb[c];
+    out.sun[c] = sun > 0.0 ? (moved.light.sun_rgb[c] / sun - 1.0) / kBias : 0.0;
+    out.sky[c] = sky > 0.0 ? (moved.light.sky_rgb[c] / sky - 1.0) / kBias : 1.0;
+  }
+  out.known = true;
+  return out;
+}
+
 LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
                             const std::vector<Sample>& samples, const SunSkyFitSummary& fit,
-                            const std::vector<uint32_t>& surface_of_pixel, const SkyShapeSpread& shape) {
+                            const std::vector<uint32_t>& surface_of_pixel, const SkyShapeSpread& shape,
+                            const StrataSensitivity& sensitivity) {
   LightInterval out;
   if (!fit.IsUsable()) return out;
   out.known = true;
@@ -156,12 +187,18 @@ LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFit
   // Without shadowed samples E_sky rests on the sunlit ones alone: their error, unamplified, is the
   // least it can have.
   const glm::dvec3 shadowed_delta = strata.shadowed_n > 0.0 ? shadowed_error.error : glm::max(lit_error.error, glm::dvec3(options.floor));
-  const glm::dvec3 sky = glm::sqrt(glm::pow(shadowed_delta / q, glm::dvec3(2.0)) +
-                                   glm::pow((1.0 - q) / q * lit_error.error, glm::dvec3(2.0)));
+  const glm::dvec3 sky = sensitivity.known
+                             ? glm::sqrt(glm::pow(sensitivity.sky * shadowed_delta, glm::dvec3(2.0)) +
+                                         glm::pow((1.0 - sensitivity.sky) * lit_error.error, glm::dvec3(2.0)))
+                             : glm::sqrt(glm::pow(shadowed_delta / q, glm::dvec3(2.0)) +
+                                         glm::pow((1.0 - q) / q * lit_error.error, glm::dvec3(2.0)));
   out.sky = glm::min(options.z * glm::sqrt(sky * sky + shape.sky * shape.sky), glm::dvec3(options.max_half_width));
   out.sun_observed = strata.lit_n > 0.0 && glm::compMin(s) >= fit_options.absent_sun_share;
   if (out.sun_observed) {
-    const glm::dvec3 sun = glm::sqrt(glm::pow(lit_error.error / s, glm::dvec3(2.0)) + glm::pow((1.0 - s) / s * sky, glm::dvec3(2.0)));
+    const glm::dvec3 sun = sensitivity.known
+                               ? glm::sqrt(glm::pow(sensitivity.sun * shadowed_delta, glm::dvec3(2.0)) +
+                                           glm::pow((1.0 - sensitivity.sun) * lit_error.error, glm::dvec3(2.0)))
+                               : glm::sqrt(glm::pow(lit_error.error / s, glm::dvec3(2.0)) + glm::pow((1.0 - s) / s * sky, glm::dvec3(2.0)));
     out.sun = glm::min(options.z * glm::sqrt(sun * sun + shape.sun * shape.sun), glm::dvec3(options.max_half_width));
   } else {
     out.sun = glm::dvec3(options.max_half_width);

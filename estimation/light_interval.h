@@ -18,8 +18,10 @@
 //   E_sky:  e_sky² = (δ_shadowed / q)² + ((1 − q)/q · δ_sunlit)²
 //   E_sun:  e_sun² = (δ_sunlit / s)² + ((1 − s)/s · e_sky)²
 //
-// and the 90% interval is ±1.645·e (a normal error), with the sky shape's spread (SkyShapeSpreadOfFit,
-// what the frame cannot tell of the sky's shape) added to e in quadrature. A sun under
+// or, where the estimator has measured it, as the fit itself passes it (StrataSensitivityOfFit:
+// the sunlit samples tell the fit of E_sky too). The 90% interval is ±1.645·e (a normal error),
+// with the sky shape's spread (SkyShapeSpreadOfFit, what the frame cannot tell of the sky's
+// shape) added to e in quadrature. A sun under
 // `absent_sun_share` of the sunlit samples' light is not observed: its interval says so
 // (observed = false) rather than a width.
 #pragma once
@@ -40,11 +42,13 @@ struct LightIntervalOptions {
                                // under the true light agree within 1-2% (tests/transfer_truth_recording_test.cc)
   double z = 1.645;            // the normal quantile of a two-sided 90% interval
   double max_half_width = 10;  // relative; beyond it the value says nothing (10 = ±1000%)
-  // The sky's shape (SkyShapeSpreadOfFit): its refits take `sky_shape_iterations` of the fit's
-  // reweighting steps, and the estimator makes them on a usable frame at least `sky_shape_every_s`
-  // after the last that had them (a cloud takes seconds to pass), the frames between keeping the
-  // last spread: the same cost a second whatever the frame rate.
+  // The sky's shape (SkyShapeSpreadOfFit) and the fit's sensitivity to each stratum
+  // (StrataSensitivityOfFit): their refits take `sky_shape_iterations` of the fit's reweighting
+  // steps, and the estimator makes them on a usable frame at least `sky_shape_every_s` after the
+  // last that had them (a cloud takes seconds to pass), the frames between keeping the last: the
+  // same cost a second whatever the frame rate.
   bool sky_shape = true;
+  bool strata_sensitivity = true;
   int sky_shape_iterations = 3;
   double sky_shape_every_s = 2.0;
   std::string Check() const;
@@ -54,6 +58,16 @@ struct LightIntervalOptions {
 // relative, one standard deviation, per channel.
 struct SkyShapeSpread {
   glm::dvec3 sun{0.0}, sky{0.0};
+};
+
+// How the fit passes a stratum's error on to E_sun and E_sky: the relative change of each per unit
+// relative bias of the shadowed stratum's radiance, per channel, signed. The fit is scale-free (all
+// samples brighter by a factor give the light brighter by it), so the sunlit stratum's (grazing
+// samples with it) is 1 minus it. known = false: not measured (IntervalOfFit then takes each term
+// as measured by one stratum alone, below).
+struct StrataSensitivity {
+  glm::dvec3 sun{0.0}, sky{1.0};
+  bool known = false;
 };
 
 // Relative half-widths of the 90% intervals (0.05: ±5%), per channel.
@@ -70,10 +84,28 @@ struct LightInterval {
 
 // The interval of `fit`, made from `samples`; `surface_of_pixel` is the bake's camera surface map
 // (Sample::pixel indexes it). An unusable fit gives known = false. `shape`'s spread is added to
-// each term's in quadrature.
+// each term's in quadrature. With `sensitivity` known, each stratum's error δ passes to E_sun and
+// E_sky as the fit passes it (StrataSensitivityOfFit):
+//
+//   e_sky² = (k_sky · δ_shadowed)² + ((1 − k_sky) · δ_sunlit)²,  e_sun² = (k_sun · δ_shadowed)² + ((1 − k_sun) · δ_sunlit)²
+//
+// else by the shares s and q of the file's header, as if E_sky were measured by the shadowed
+// samples alone and E_sun by the sunlit ones given E_sky.
 LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
                             const std::vector<Sample>& samples, const SunSkyFitSummary& fit,
-                            const std::vector<uint32_t>& surface_of_pixel, const SkyShapeSpread& shape = {});
+                            const std::vector<uint32_t>& surface_of_pixel, const SkyShapeSpread& shape = {},
+                            const StrataSensitivity& sensitivity = {});
+
+// The fit's sensitivity to the shadowed stratum: every second of `samples` refitted
+// (sky_shape_iterations of the fit's reweighting steps) as they are and with the shadowed samples'
+// radiance 2% higher. The
+// shares' rule above takes E_sky as resting on the shadowed samples alone; the fit also draws it
+// from the sky's part of the sunlit samples' light (a quarter of it and more under a low sun), and
+// on the bundled recordings the shadowed samples move E_sky by 0.2-1.0 times their bias where q's
+// rule says 1.1-3.5 (docs/estimation.md). Unknown (known = false) for an unusable fit or one
+// without sunlit samples.
+StrataSensitivity StrataSensitivityOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
+                                         const std::vector<Sample>& samples, const SunSkyFitSummary& fit);
 
 // The sky's shape. The fit mixes two: the captured clear sky re-aimed (E_clear) and a uniform one
 // (E_overcast). A sky of another shape (another haze, thin cloud, a photographed sky unlike the
