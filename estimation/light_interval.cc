@@ -46,6 +46,9 @@ struct StrataErrors {
   StratumError lit, shadowed;
   double lit_n = 0.0, shadowed_n = 0.0;
   glm::dvec3 s{0.0}, q{1.0};  // the sun's share of the sunlit samples' light, the sky's of the shadowed ones'
+  // Over the sunlit samples: Σ of their radiance per unit E_sun, and Σ of their predicted radiance
+  // from the sky (and the light the model reflects onto them) under the fit.
+  glm::dvec3 lit_unit_sun{0.0}, lit_sky{0.0};
   // Σ over both strata of surfaces × δ² (worst channel): how much the surfaces disagree, all told.
   double Disagreement() const {
     const double a = glm::compMax(lit.error), b = glm::compMax(shadowed.error);
@@ -60,6 +63,7 @@ StrataErrors ErrorsOfFit(const LightIntervalOptions& options, const SunSkyFitOpt
   StrataErrors out;
   const LightParts all = SplitLight(fit.light, fit.overcast_share);
   const LightParts sun_only{all.sun, glm::vec3(0.0f), glm::vec3(0.0f)}, sky_only{glm::vec3(0.0f), all.clear, all.overcast};
+  const LightParts unit_sun{glm::vec3(1.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
   // Relative residuals by stratum and surface, and each stratum's share of its light from the term
   // it measures (a mean of shares, as the fit's SplitShares).
   std::vector<SurfaceResiduals> lit, shadowed;  // by surface
@@ -84,6 +88,8 @@ StrataErrors ErrorsOfFit(const LightIntervalOptions& options, const SunSkyFitOpt
     r.n += 1.0;
     if (is_lit) {
       sun_share += glm::dvec3(sun / predicted), out.lit_n += 1.0;
+      out.lit_unit_sun += glm::dvec3(PredictedRadiance(s, unit_sun));
+      out.lit_sky += glm::dvec3(predicted - sun);
     } else {
       sky_share += glm::dvec3(1.0f - sun / predicted), out.shadowed_n += 1.0;
     }
@@ -93,6 +99,30 @@ StrataErrors ErrorsOfFit(const LightIntervalOptions& options, const SunSkyFitOpt
   out.s = out.lit_n > 0.0 ? glm::clamp(sun_share / out.lit_n, 0.0, 1.0) : glm::dvec3(0.0);
   out.q = out.shadowed_n > 0.0 ? glm::clamp(sky_share / out.shadowed_n, 1e-3, 1.0) : glm::dvec3(1.0);
   return out;
+}
+
+// The largest sun a frame would not have seen. The sun is not observed where its share of the
+// sunlit samples' light is under a = absent_sun_share in its worst channel w; there that share
+// would be a with a sun of a/(1 − a) · sky_w / unit_w (the sums' ratio). The other channels have
+// no such rule (a red sun can be seen in red and not in blue), so they take the sun's colour: the
+// one carried (estimation/sun_colour.h), else the fit's own, else each channel's own share rule.
+glm::dvec3 SunBound(const SunSkyFitOptions& fit_options, const SunSkyFitSummary& fit, const StrataErrors& strata) {
+  glm::dvec3 out(0.0);
+  if (!(strata.lit_n > 0.0) || !(glm::compMin(strata.lit_unit_sun) > 0.0)) return out;
+  const double a = fit_options.absent_sun_share;
+  const glm::dvec3 own = a / (1.0 - a) * strata.lit_sky / strata.lit_unit_sun;
+  int w = 0;
+  for (int c = 1; c < 3; ++c) {
+    if (strata.s[c] < strata.s[w]) w = c;
+  }
+  glm::dvec3 colour(0.0);
+  if (fit.carried_weight > 0.0 && glm::compMin(fit.carried_colour) > 0.0) {
+    colour = fit.carried_colour;
+  } else if (glm::compMin(fit.light.sun_rgb) > 0.0) {
+    colour = fit.light.sun_rgb;
+  }
+  if (!(glm::compMin(colour) > 0.0)) return own;
+  return glm::max(own, own[w] * colour / colour[w]);
 }
 
 }  // namespace
@@ -202,6 +232,7 @@ LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFit
     out.sun = glm::min(options.z * glm::sqrt(sun * sun + shape.sun * shape.sun), glm::dvec3(options.max_half_width));
   } else {
     out.sun = glm::dvec3(options.max_half_width);
+    out.sun_bound = SunBound(fit_options, fit, strata);
   }
   return out;
 }
@@ -209,7 +240,8 @@ LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFit
 IntervalBounds BoundsOf(const SunSky& light, const LightInterval& interval) {
   IntervalBounds out;
   for (int c = 0; c < 3; ++c) {
-    out.sun[c] = {std::max(0.0, light.sun_rgb[c] * (1.0 - interval.sun[c])), light.sun_rgb[c] * (1.0 + interval.sun[c])};
+    out.sun[c] = {std::max(0.0, light.sun_rgb[c] * (1.0 - interval.sun[c])),
+                  std::max(light.sun_rgb[c] * (1.0 + interval.sun[c]), interval.sun_bound[c])};
     out.sky[c] = {std::max(0.0, light.sky_rgb[c] * (1.0 - interval.sky[c])), light.sky_rgb[c] * (1.0 + interval.sky[c])};
   }
   return out;

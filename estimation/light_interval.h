@@ -74,6 +74,10 @@ struct StrataSensitivity {
 struct LightInterval {
   glm::dvec3 sun{0.0}, sky{0.0};
   bool sun_observed = false;  // false: no sunlit samples, or the sun too weak a part of their light
+  // A sun not observed among sunlit samples: the largest E_sun the frame would not have seen, per
+  // channel (absolute; 0 otherwise): the one that would be absent_sun_share of their light in the
+  // worst channel, the others by the sun's colour. BoundsOf's upper bound is at least this.
+  glm::dvec3 sun_bound{0.0};
   bool known = false;         // false: nothing fitted (the interval of a held frame is the last one's)
   // The strata's model errors (δ above, worst channel) and how many surfaces each had.
   double sunlit_error = 0.0, shadowed_error = 0.0;
@@ -122,7 +126,8 @@ SkyShapeSpread SkyShapeSpreadOfFit(const LightIntervalOptions& options, const Su
                                    const std::vector<uint32_t>& surface_of_pixel);
 
 // The interval's bounds around `light` per channel: [v·(1 − h), v·(1 + h)], the low bound at
-// least 0 (x: low, y: high). A sun not observed has [0, v·(1 + max_half_width)].
+// least 0 (x: low, y: high). A sun not observed has [0, v·(1 + max_half_width)], the high bound at
+// least its sun_bound: an estimate of 0 is not a bound of 0.
 struct IntervalBounds {
   std::array<glm::dvec2, 3> sun, sky;
 };

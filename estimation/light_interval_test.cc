@@ -193,6 +193,25 @@ TEST(LightIntervalTest, ASunTooWeakToMeasureIsSaidNotObservedAndItsBoundsAreOpen
   EXPECT_EQ(bounds.sun[0].x, 0.0);
   EXPECT_NEAR(bounds.sun[0].y, fit.light.sun_rgb.x * (1.0 + options.max_half_width), 1e-9);
   EXPECT_LT(interval.sky.x, 0.05);  // the sky is still measured
+  // Its bound: in the worst channel (blue), the sun that would be 5% of the sunlit samples' light
+  // beside the sky's, a/(1 − a) · Σ sky / Σ unit sun over them; red and green by the sun's colour.
+  // Above the true sun in every channel, and an estimate of 0 is not a bound of 0.
+  glm::dvec3 sky_light(0.0), unit_sun(0.0);
+  for (const Sample& x : samples) {
+    if (!IsSunlit(x, fit_options)) continue;
+    for (int c = 0; c < 3; ++c) {
+      const double rho = x.albedo[c] / glm::pi<double>();
+      sky_light[c] += rho * x.sky[c] * kClear.sky_rgb[c];
+      unit_sun[c] += rho * x.sun[c];
+    }
+  }
+  EXPECT_NEAR(interval.sun_bound.z / (0.05 / 0.95 * sky_light.z / unit_sun.z), 1.0, 0.05);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_GT(interval.sun_bound[c], weak.sun_rgb[c]) << c;
+    EXPECT_LT(interval.sun_bound[c], 3.0 * weak.sun_rgb[c]) << c;
+    const SunSky zero{glm::dvec3(0.0), fit.light.sky_rgb};
+    EXPECT_DOUBLE_EQ(BoundsOf(zero, interval).sun[c].y, interval.sun_bound[c]) << c;
+  }
 }
 
 // The fit's sensitivity to a stratum's bias, against the fit itself: the shadowed samples 5%

@@ -120,7 +120,7 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
     r.burst = b;
     r.first_frame = frames[b.begin].frame, r.last_frame = frames[b.end - 1].frame;
     r.sun_elevation_deg = frames[b.begin].sun_elevation_deg;
-    std::array<std::vector<double>, 3> sun, sky, sun_error, sky_error, sun_half, sky_half;
+    std::array<std::vector<double>, 3> sun, sky, sun_error, sky_error, sun_half, sky_half, sun_bound;
     std::vector<double> confidence, sunlit, shadowed;
     r.min_confidence = 1.0;
     for (size_t i = b.begin; i < b.end; ++i) {
@@ -136,6 +136,7 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
         sun[k].push_back(f.light.sun_rgb[static_cast<int>(k)]), sky[k].push_back(f.light.sky_rgb[static_cast<int>(k)]);
         if (f.interval.known) {
           sun_half[k].push_back(f.interval.sun[static_cast<int>(k)]), sky_half[k].push_back(f.interval.sky[static_cast<int>(k)]);
+          if (!f.interval.sun_observed) sun_bound[k].push_back(f.interval.sun_bound[static_cast<int>(k)]);
         }
         if (truth == nullptr) continue;
         const estimation::SunSky& t = truth->truth[i];
@@ -151,6 +152,7 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
       const size_t k = static_cast<size_t>(c);
       r.sun[c] = Median(sun[k]), r.sky[c] = Median(sky[k]);
       if (!sun_half[k].empty()) r.sun_half_width[c] = Median(sun_half[k]), r.sky_half_width[c] = Median(sky_half[k]);
+      if (!sun_bound[k].empty() && 2 * sun_bound[k].size() >= sun_half[k].size()) r.sun_bound[c] = Median(sun_bound[k]);
       if (r.has_truth) r.sun_error[c] = Median(sun_error[k]), r.sky_error[c] = Median(sky_error[k]);
     }
     if (r.has_truth) {
@@ -180,7 +182,7 @@ std::string BurstsCsv(const std::vector<BurstLighting>& bursts) {
     csv += fmt::format(",{},{},{},{}", b.sunlit_samples, b.shadowed_samples, b.frames_without_sunlit,
                        b.frames_without_shadowed);
     estimation::LightInterval interval;
-    interval.sun = b.sun_half_width, interval.sky = b.sky_half_width;
+    interval.sun = b.sun_half_width, interval.sky = b.sky_half_width, interval.sun_bound = b.sun_bound;
     csv += estimation::IntervalCsvFields(estimation::BoundsOf({b.sun, b.sky}, interval));
     csv += fmt::format(",{}", b.frames_sun_not_observed);
     if (truth) {

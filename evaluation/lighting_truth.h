@@ -73,6 +73,9 @@ struct BurstLighting {
   // of the sunlit samples' light for a width to mean anything).
   glm::dvec3 sun_half_width{NAN}, sky_half_width{NAN};
   int frames_sun_not_observed = 0;
+  // Where the sun is not observed in half the burst's frames or more: the median of those frames'
+  // sun_bound (light_interval.h), which the burst's E_sun bound in bursts.csv is at least; else 0.
+  glm::dvec3 sun_bound{0.0};
   bool has_truth = false;
   glm::dvec3 sun_error{NAN}, sky_error{NAN};
   // With truth: each of the six errors within its half-width (E_sun's only where observed).

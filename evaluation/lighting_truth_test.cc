@@ -86,6 +86,27 @@ TEST(LightingTruthTest, EachBurstHasItsOwnMedianErrors) {
   EXPECT_TRUE(std::isnan(CompareBursts(frames, nullptr)[0].sun_error.x));
 }
 
+// A burst whose sun is not observed in most frames, estimated at 0: its E_sun bound in bursts.csv
+// is the median of those frames' sun_bound, not 0; a burst where it is observed in most has none.
+TEST(LightingTruthTest, ABurstWhoseSunIsNotObservedIsBoundedByWhatItsFramesWouldHaveSeen) {
+  std::vector<estimation::FrameEstimate> frames = Frames();
+  for (estimation::FrameEstimate& f : frames) {
+    f.light.sun_rgb = glm::dvec3(0.0);
+    f.interval.known = true, f.interval.sun_observed = false;
+    f.interval.sun = glm::dvec3(10.0), f.interval.sky = glm::dvec3(0.1);
+    f.interval.sun_bound = glm::dvec3(1.0, 2.0, 3.0) * static_cast<double>(f.frame + 1);
+  }
+  frames[4].interval.sun_observed = frames[5].interval.sun_observed = true;  // burst 1: observed in two of three
+  frames[4].interval.sun = frames[5].interval.sun = glm::dvec3(0.2);
+  const std::vector<BurstLighting> bursts = CompareBursts(frames, nullptr);
+  ASSERT_EQ(bursts.size(), 3u);
+  EXPECT_EQ(bursts[0].sun_bound, glm::dvec3(2.0, 4.0, 6.0));  // frames 0-2: bounds 1, 2, 3 times (1, 2, 3)
+  EXPECT_EQ(bursts[1].sun_bound, glm::dvec3(0.0));
+  const std::string csv = BurstsCsv(bursts);
+  // Burst 0: E_sun 0, 0, 0 with [0, 2], [0, 4], [0, 6]; E_sky 2 ± 10%.
+  EXPECT_NE(csv.find(",0,2,0,4,0,6,1.8,2.2,"), std::string::npos) << csv;
+}
+
 TEST(LightingTruthTest, ConfidenceRankingIsTheAucOfBadFramesAgainstGoodOnes) {
   // Errors: two bad frames (> 10%), three good (≤ 5%), one in between and one without truth,
   // which count as neither.
