@@ -315,7 +315,8 @@ void ReportBursts(const std::vector<BurstLighting>& bursts, const std::filesyste
     if (b.frames_sun_not_observed > 0) {
       report->Say(fmt::format("  burst {}: E_sun not observed in {} of {} frames: the sun below the horizon, or too weak "
                               "a part of the sunlit samples' light (behind cloud) to be told from the sky; its interval "
-                              "there runs from 0 to 11 times the value, which says nothing",
+                              "there runs from 0 to 11 times the value, and at least to the largest sun those frames "
+                              "would not have seen",
                               b.burst.index, b.frames_sun_not_observed, frames));
     }
   }
