@@ -13,7 +13,7 @@ namespace {
 
 // One surface's samples in one stratum: their relative residuals, clipped, summed.
 struct SurfaceResiduals {
-  glm::dvec3 sum{0.0};
+  glm::dvec3 sum{0.0}, sum_sq{0.0};
   double n = 0.0;
 };
 
@@ -22,22 +22,29 @@ struct SurfaceResiduals {
 struct StratumError {
   glm::dvec3 error{0.0};
   int surfaces = 0;
+  // What the likelihood of a sky shape reads (SkyShapeSpreadOfFit): the surfaces' mean square
+  // bias as the frame shows it, without the floor or the K/(K − 1), plus the noise of each
+  // surface's mean (its samples' scatter over their count), per channel.
+  glm::dvec3 observed{0.0};
 };
 
 StratumError ErrorOfStratum(const std::vector<SurfaceResiduals>& surfaces, double floor) {
   StratumError out;
-  glm::dvec3 sum_sq(0.0);
+  glm::dvec3 sum_sq(0.0), noise(0.0);
   double n = 0.0;
   for (const SurfaceResiduals& r : surfaces) {
     if (r.n < 3.0) continue;
     ++out.surfaces;
     const glm::dvec3 bias = r.sum / r.n;
     sum_sq += r.n * bias * bias;
+    // n × the variance of the surface's mean: its samples' variance.
+    noise += glm::max(r.sum_sq / r.n - bias * bias, glm::dvec3(0.0)) * (r.n / (r.n - 1.0));
     n += r.n;
   }
   const double k = out.surfaces;
   const glm::dvec3 variance = out.surfaces >= 2 ? sum_sq / n * (k / (k - 1.0)) : glm::dvec3(0.0);
   out.error = glm::max(glm::sqrt(variance), glm::dvec3(floor));
+  if (n > 0.0) out.observed = (sum_sq + noise) / n;
   return out;
 }
 
@@ -49,10 +56,10 @@ struct StrataErrors {
   // Over the sunlit samples: Σ of their radiance per unit E_sun, and Σ of their predicted radiance
   // from the sky (and the light the model reflects onto them) under the fit.
   glm::dvec3 lit_unit_sun{0.0}, lit_sky{0.0};
-  // Σ over both strata of surfaces × δ² (worst channel): how much the surfaces disagree, all told.
+  // Σ over both strata of surfaces × their observed mean square bias (worst channel): how much
+  // the surfaces disagree, all told, as the frame shows it.
   double Disagreement() const {
-    const double a = glm::compMax(lit.error), b = glm::compMax(shadowed.error);
-    return lit.surfaces * a * a + shadowed.surfaces * b * b;
+    return lit.surfaces * glm::compMax(lit.observed) + shadowed.surfaces * glm::compMax(shadowed.observed);
   }
   int Surfaces() const { return lit.surfaces + shadowed.surfaces; }
 };
@@ -84,7 +91,9 @@ StrataErrors ErrorsOfFit(const LightIntervalOptions& options, const SunSkyFitOpt
       stratum.resize(surface + 1);
     }
     SurfaceResiduals& r = stratum[surface];
-    r.sum += glm::dvec3(glm::clamp(s.radiance / predicted - 1.0f, -clip, clip));
+    const glm::dvec3 residual(glm::clamp(s.radiance / predicted - 1.0f, -clip, clip));
+    r.sum += residual;
+    r.sum_sq += residual * residual;
     r.n += 1.0;
     if (is_lit) {
       sun_share += glm::dvec3(sun / predicted), out.lit_n += 1.0;

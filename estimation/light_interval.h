@@ -117,7 +117,10 @@ StrataSensitivity StrataSensitivityOfFit(const LightIntervalOptions& options, co
 // surfaces' disagreement above does not show it. So the frame is refitted with its whole sky of
 // each shape; each refit is weighed by its likelihood against the fit's own, the surfaces' biases
 // taken as normal with an unknown common variance (profiled out): (D²_refit / D²_own)^(−K/2), D²
-// the sum over both strata of surfaces × δ² and K the surfaces. The spread is the root of the
+// the sum over both strata of surfaces × their mean square bias as the frame shows it (worst
+// channel; not δ: without δ's floor, which hides every difference under it, and with the noise of
+// each surface's mean added, so that two shapes both within the pixels' noise weigh alike) and K
+// the surfaces. The spread is the root of the
 // weighted mean square of the refits' relative differences in E_sun and E_sky from the fit's (the
 // fit's own shape counted with weight 1 and difference 0): the between-model part of a Bayesian
 // model average's variance.

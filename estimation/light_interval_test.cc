@@ -154,6 +154,38 @@ TEST(LightIntervalTest, ASkyShapeTheSurfacesTellApartAddsNothing) {
   }
 }
 
+TEST(LightIntervalTest, ASkyShapeTheSurfacesTellApartWithinTheFloorAddsNothing) {
+  // The true sky is the captured clear one, close to uniform, the pixels noisy by 2%: the uniform
+  // refit leaves the surfaces about 1% apart, under the interval's 2% floor, but many times further
+  // apart than the fit's own, whose surfaces agree within their noise. The likelihood reads that
+  // disagreement as the frame shows it; read through the floor, both shapes looked alike and the
+  // spread was half their distance.
+  const std::array<double, kSurfaces> clear{1.075, 1.045, 1.07, 1.05};
+  std::mt19937 rng(17);
+  std::vector<Sample> samples = ShapedSamples(kClear, clear, clear, {0.0, 0.0, 0.0, 0.0}, 4000, rng);
+  std::normal_distribution<float> noise(0.0f, 0.02f);
+  for (Sample& s : samples) s.radiance *= 1.0f + noise(rng);
+  const SunSkyFitOptions fit_options;
+  const SunSkyFitSummary fit = FitSunSky(fit_options, samples);
+  ASSERT_TRUE(fit.IsUsable());
+  const std::vector<uint32_t> surface = SurfaceOfPixel(samples.size());
+  const SkyShapeSpread shape = SkyShapeSpreadOfFit({}, fit_options, samples, fit, surface);
+  // The uniform refit: its E_sky is a few percent from the fit's, its surfaces within the floor.
+  std::vector<Sample> uniform = samples;
+  for (Sample& s : uniform) s.sky = s.overcast;
+  const SunSkyFitSummary refit = FitSunSky(fit_options, uniform);
+  ASSERT_TRUE(refit.IsUsable());
+  const LightInterval refit_interval = IntervalOfFit({}, fit_options, uniform, refit, surface);
+  for (int c = 0; c < 3; ++c) {
+    std::printf("channel %d: uniform refit E_sky %+.1f%%, its strata %.3f %.3f; spread %.2f%%\n", c,
+                100 * (refit.light.sky_rgb[c] / fit.light.sky_rgb[c] - 1.0), refit_interval.sunlit_error,
+                refit_interval.shadowed_error, 100 * shape.sky[c]);
+    EXPECT_GT(std::abs(refit.light.sky_rgb[c] / fit.light.sky_rgb[c] - 1.0), 0.01) << c;
+    EXPECT_LT(shape.sky[c], 0.005) << c;
+    EXPECT_LT(shape.sun[c], 0.005) << c;
+  }
+}
+
 TEST(LightIntervalTest, ASkyShapeTheSurfacesCannotTellWidensTheInterval) {
   // A uniform sky, surfaces off by -15% to +20% (a window, gloss, a wrong albedo): refitted with a
   // clear-shaped sky they disagree about as much, and the two shapes' E_sky are far apart, so the
