@@ -149,6 +149,7 @@ std::vector<Sample> Sampler::Draw(const cv::Mat& frame, double exposure, const c
       s.overcast = stratum[k].transfer.overcast;
       s.sunlit = sunlit_[i] != 0;
       s.pixel = i;
+      s.surface = gbuffer_.surface[i];
       samples.push_back(s);
       ++taken;
     }

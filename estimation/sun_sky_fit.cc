@@ -92,7 +92,9 @@ std::string SunSkyFitOptions::Check() const {
                        InClosed("min_stratum_samples", min_stratum_samples, 1, 1000000),
                        InOpenClosed("confident_residual", confident_residual, 0.0, 10.0),
                        InOpenClosed("confident_share", confident_share, 0.0, 1.0),
-                       InOpenClosed("absent_sun_share", absent_sun_share, 0.0, confident_share)});
+                       InOpenClosed("absent_sun_share", absent_sun_share, 0.0, confident_share),
+                       InClosed("min_shadow_information", min_shadow_information, 0.0, 1.0),
+                       InClosed("surface_model_error", surface_model_error, 0.0, 1.0)});
 }
 
 namespace {
@@ -147,6 +149,133 @@ class ChannelFitter {
   bool converged() const { return converged_; }
   // The normal equations at the last fit's final weights (for the channel it was loaded with).
   NormalEquations FinalEquations() { return Equations(); }
+
+  // After a fit without the split (`fit`, over `rows`): E_sun as each surface's own shadows show
+  // it (SunSkyFitOptions::sun_from_shadows). y ≈ E_sun·x_sun + g_s·L_sky with L_sky the fitted
+  // sky's radiance at the sample and g_s a gain per surface s, profiled out: with per-surface sums
+  // S_ll = Σ w L², S_xl = Σ w x L, S_ly = Σ w L y,
+  //   E_sun = (Σ w x y − Σ_s S_xl·S_ly / S_ll) / (Σ w x² − Σ_s S_xl² / S_ll),
+  // the denominator its information; IRLS from `fit` with Reweight's weights. Also the whole-scene
+  // model's information on E_sun at the same weights (Σ w x² less its part shared with the clear
+  // sky), and the numerator, for a sun of given colour.
+  struct WithinSurfaces {
+    double sun = 0.0, numerator = 0.0, information = 0.0, scene_information = 0.0;
+    // How far the surfaces' gains differ: their relative standard deviation (weighted by each
+    // surface's S_ll, × K/(K − 1) in variance for K surfaces).
+    double gain_spread = 0.0;
+    // The variance of `sun` from the samples' scatter: the weighted mean square residual (relative,
+    // at Reweight's weights) over the information.
+    double variance = 0.0;
+  };
+  // Before SunWithinSurfaces, once for all channels: each of `rows`' surface, and which surfaces
+  // tell the sun by their own shadow: those with both sunlit and shadowed samples,
+  // min_stratum_samples of each. On the others the sun term varies only by the light reflected onto
+  // them, and their contrasts say more of that model than of the sun.
+  void PrepareSurfaces(const std::vector<size_t>& rows) {
+    surface_of_row_.resize(rows.size());
+    surfaces_ = 0;
+    for (size_t k = 0; k < rows.size(); ++k) {
+      // Surfaces beyond the table (none in a model of fewer than 65536) share its last entry.
+      surface_of_row_[k] = std::min<uint32_t>(samples_[rows[k]].surface, kMaxSurfaces - 1);
+      surfaces_ = std::max(surfaces_, surface_of_row_[k] + 1);
+    }
+    std::vector<std::array<int, 2>> strata(surfaces_, {0, 0});
+    for (size_t k = 0; k < rows.size(); ++k) {
+      const Sample& s = samples_[rows[k]];
+      if (IsSunlit(s, options_)) {
+        ++strata[surface_of_row_[k]][0];
+      } else if (!s.sunlit) {
+        ++strata[surface_of_row_[k]][1];
+      }
+    }
+    casting_.assign(surfaces_, 0);
+    for (uint32_t j = 0; j < surfaces_; ++j) {
+      casting_[j] = std::min(strata[j][0], strata[j][1]) >= options_.min_stratum_samples ? 1 : 0;
+    }
+  }
+
+  WithinSurfaces SunWithinSurfaces(const ChannelFit& fit, const NormalEquations& equations) {
+    WithinSurfaces out;
+    // The whole scene's information on the sun, its clear sky profiled out, at the same weights.
+    out.scene_information = equations.a[1][1] > 0.0 ? equations.a[0][0] - equations.a[0][1] * equations.a[0][1] / equations.a[1][1]
+                                                    : equations.a[0][0];
+    const uint32_t surfaces = surfaces_;
+    gain_.assign(surfaces, 1.0);
+    sums_.resize(surfaces);
+    const double inv_scale = 1.0 / options_.cauchy_scale;
+    double sun = fit[0];
+    for (int iteration = 0; iteration < options_.iterations; ++iteration) {
+      // Per surface: S_ll, S_xl, S_ly, S_xx, S_xy, Σ w d² and the rows.
+      std::fill(sums_.begin(), sums_.end(), Sums{});
+      for (size_t k = 0; k < m_; ++k) {
+        // The fitted sky's radiance (the given overcast part and the clear one).
+        const double x = x_[0][k], l = offset_[k] + x_[1][k] * fit[1] + x_[2][k] * fit[2], y = y_[k];
+        const double prediction = x * sun + gain_[surface_of_row_[k]] * l, d = y - prediction;
+        // The first pass is at the scene fit's own final weights (every gain 1, its sun).
+        const double p = std::max(prediction, floor_);
+        const double w = iteration == 0 ? w_[k] : 1.0 / (p * p + d * d * inv_scale * inv_scale);
+        Sums& s = sums_[surface_of_row_[k]];
+        s[0] += w * l * l, s[1] += w * x * l, s[2] += w * l * y, s[3] += w * x * x, s[4] += w * x * y;
+        s[5] += w * d * d, s[6] += 1.0;
+      }
+      double numerator = 0.0, information = 0.0, scatter = 0.0, count = 0.0;
+      for (uint32_t j = 0; j < surfaces; ++j) {
+        const Sums& s = sums_[j];
+        if (!casting_[j] || !(s[0] > 0.0)) continue;
+        numerator += s[4] - s[1] * s[2] / s[0], information += s[3] - s[1] * s[1] / s[0];
+        scatter += s[5], count += s[6];
+      }
+      out.numerator = numerator, out.information = information;
+      out.variance = information > 0.0 && count > 0.0 ? scatter / count / information : 0.0;
+      const double next = information > 0.0 ? std::max(0.0, numerator / information) : sun;
+      for (uint32_t j = 0; j < surfaces; ++j) {
+        const Sums& s = sums_[j];
+        gain_[j] = s[0] > 0.0 ? (s[2] - s[1] * next) / s[0] : 1.0;
+      }
+      const double change = std::abs(next - sun) / std::max({next, sun, 1e-30});
+      sun = next;
+      if (change < 1e-4) break;
+    }
+    out.sun = sun;
+    out.gain_spread = GainSpread(surfaces);
+    return out;
+  }
+
+  // After a fit without the split (`fit`), before SunWithinSurfaces: the gains' spread (GainSpread)
+  // at the fit's own sun and final weights, one pass. Within the model's known error the scene's
+  // fit stands (FitSunSky's ρ is 0) and the shadows' estimate is not needed.
+  double GainSpreadAt(const ChannelFit& fit) {
+    const uint32_t surfaces = surfaces_;
+    gain_.assign(surfaces, 1.0);
+    sums_.assign(surfaces, Sums{});
+    for (size_t k = 0; k < m_; ++k) {
+      const double x = x_[0][k], l = offset_[k] + x_[1][k] * fit[1] + x_[2][k] * fit[2], w = w_[k];
+      Sums& s = sums_[surface_of_row_[k]];
+      s[0] += w * l * l, s[1] += w * x * l, s[2] += w * l * y_[k];
+    }
+    for (uint32_t j = 0; j < surfaces; ++j) {
+      const Sums& s = sums_[j];
+      gain_[j] = s[0] > 0.0 ? (s[2] - s[1] * fit[0]) / s[0] : 1.0;
+    }
+    return GainSpread(surfaces);
+  }
+
+  // The relative spread of the first `surfaces` gains (SunWithinSurfaces; weighted by S_ll, × K/(K − 1)
+  // in variance): every surface's gain says how far the scene's sky is off there, casting a shadow
+  // or not.
+  double GainSpread(uint32_t surfaces) const {
+    double weight = 0.0, mean = 0.0, k = 0.0;
+    for (uint32_t j = 0; j < surfaces; ++j) {
+      if (sums_[j][0] > 0.0) weight += sums_[j][0], mean += sums_[j][0] * gain_[j], k += 1.0;
+    }
+    if (!(k >= 2.0 && weight > 0.0 && mean > 0.0)) return 0.0;
+    mean /= weight;
+    double variance = 0.0;
+    for (uint32_t j = 0; j < surfaces; ++j) {
+      if (sums_[j][0] > 0.0) variance += sums_[j][0] * (gain_[j] - mean) * (gain_[j] - mean);
+    }
+    return std::sqrt(variance / weight * k / (k - 1.0)) / mean;
+  }
 
   // Channel `c` over the samples `rows`: with `split`, E_sun, E_clear and E_overcast; without,
   // E_sun and E_clear with E_overcast given as `overcast` (the grey part, the same in every
@@ -261,7 +390,16 @@ class ChannelFitter {
   const SunSkyFitOptions& options_;
   const std::vector<Sample>& samples_;
   const bool with_sun_;
+  static constexpr uint32_t kMaxSurfaces = 1u << 16;
   std::vector<double> y_, w_, relative_, scratch_, offset_, rest_;  // rest_: y_ less offset_
+  // SunWithinSurfaces' buffers: each row's surface and fitted sky radiance, each surface's gain
+  // and sums.
+  using Sums = std::array<double, 7>;
+  std::vector<uint32_t> surface_of_row_;
+  std::vector<uint8_t> casting_;  // per surface: it has both strata
+  uint32_t surfaces_ = 0;
+  std::vector<double> gain_;
+  std::vector<Sums> sums_;
   std::array<std::vector<double>, 3> x_;
   size_t m_ = 0;
   std::array<bool, 3> free_{};
@@ -379,6 +517,16 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   std::vector<double> spreads, all_residuals, scratch;
   all_residuals.reserve(3 * n);
   std::array<NormalEquations, 3> final_equations{};
+  // The sun from the shadows within the surfaces needs two surfaces: one surface's own sky gain is
+  // the whole scene's sky.
+  bool several_surfaces = false;
+  for (const size_t i : usable) several_surfaces = several_surfaces || samples[i].surface != samples[usable[0]].surface;
+  const bool from_shadows = options.sun_from_shadows && with_sun && several_surfaces;
+  std::array<ChannelFitter::WithinSurfaces, 3> within{};
+  if (from_shadows) fitter.PrepareSurfaces(usable);
+  std::array<double, 3> shadow_weight{0.0, 0.0, 0.0}, mixed_information{0.0, 0.0, 0.0}, mixed_sun{0.0, 0.0, 0.0};
+  double shadow_information = 1.0;  // worst channel, over those where it was needed
+  bool shadows_measured = false;
   for (int c = 0; c < 3; ++c) {
     const ChannelFit& split = split_fits[static_cast<size_t>(c)];
     const ChannelFit start{split[0], split[1], 0.0};
@@ -386,7 +534,41 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
     unconverged_channels += fitter.converged() ? 0 : 1;
     summary.light.sun_rgb[c] = fit[0];
     summary.light.sky_rgb[c] = fit[1] + overcast;
-    if (sun_colour != nullptr) final_equations[static_cast<size_t>(c)] = fitter.FinalEquations();
+    // The normal equations at the final weights: for a sun of given colour, and for the clear sky
+    // that follows the shadows' sun.
+    NormalEquations& equations = final_equations[static_cast<size_t>(c)];
+    if (sun_colour != nullptr) equations = fitter.FinalEquations();
+    if (from_shadows && fitter.GainSpreadAt(fit) > options.surface_model_error) {
+      if (sun_colour == nullptr) equations = fitter.FinalEquations();
+      const ChannelFitter::WithinSurfaces& w = within[static_cast<size_t>(c)] = fitter.SunWithinSurfaces(fit, equations);
+      const double share = w.scene_information > 0.0 ? std::clamp(w.information / w.scene_information, 0.0, 1.0) : 0.0;
+      shadow_information = std::min(shadow_information, share), shadows_measured = true;
+      // The shadows' weight: none while the surfaces' gains differ by no more than their known
+      // model error m, then 1 − m²/spread² (the part of the spread beyond m over the whole); times
+      // D²/(D² + var) with D the two estimates' difference and var what the shadows' estimate is
+      // unsure of: its samples' scatter, and the model error m of the light it rests on passed on
+      // by 1/share (it rests on that share of what the frame knows of the sun). Where the two
+      // differ by less, the scene's fit, which knows more, is kept.
+      const double m = options.surface_model_error, spread = w.gain_spread, difference = w.sun - fit[0];
+      const double model = share > 0.0 ? m * w.sun / share : 0.0;
+      const double rho = share >= options.min_shadow_information && share > 0.0 && spread > m
+                             ? (1.0 - m * m / (spread * spread)) * difference * difference /
+                                   (difference * difference + w.variance + model * model)
+                             : 0.0;
+      shadow_weight[static_cast<size_t>(c)] = rho;
+      summary.shadow_weight += rho / 3.0;
+      if (rho > 0.0) {
+        // The clear sky follows the sun at the fit's final weights.
+        const double sun = rho * w.sun + (1.0 - rho) * fit[0];
+        const double clear = equations.a[1][1] > 0.0 ? std::max(0.0, (equations.b[1] - equations.a[0][1] * sun) / equations.a[1][1]) : fit[1];
+        summary.light.sun_rgb[c] = sun;
+        summary.light.sky_rgb[c] = clear + overcast;
+        // What the channel knows of the sun, for a sun of given colour: the two informations
+        // mixed as the estimates are.
+        mixed_information[static_cast<size_t>(c)] = rho * w.information + (1.0 - rho) * w.scene_information;
+        mixed_sun[static_cast<size_t>(c)] = sun;
+      }
+    }
     scratch.clear();
     for (size_t k = 0; k < n; ++k) {
       all_residuals.push_back(std::abs(fitter.relative()[k]));
@@ -394,6 +576,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
     }
     spreads.push_back(1.4826 * MedianInPlace(scratch, 0.0));
   }
+  summary.shadow_information = shadows_measured ? shadow_information : 0.0;
   if (sun_colour != nullptr && with_sun && glm::compMin(*sun_colour) > 0.0) {
     // The sun's colour given (clouds are grey: a cloud dims the beam, it does not colour it): one
     // magnitude s for E_sun = s·colour over the three channels, each channel's clear sky profiled
@@ -404,6 +587,11 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
     for (int c = 0; c < 3; ++c) {
       const NormalEquations& eq = final_equations[static_cast<size_t>(c)];
       const double colour = (*sun_colour)[c];
+      if (shadow_weight[static_cast<size_t>(c)] > 0.0) {  // what the channel knows of the sun, shadows and all
+        const double information = mixed_information[static_cast<size_t>(c)];
+        num += colour * mixed_sun[static_cast<size_t>(c)] * information, den += colour * colour * information;
+        continue;
+      }
       if (!(eq.a[1][1] > 0.0)) continue;
       num += colour * (eq.b[0] - eq.a[0][1] * eq.b[1] / eq.a[1][1]);
       den += colour * colour * (eq.a[0][0] - eq.a[0][1] * eq.a[0][1] / eq.a[1][1]);

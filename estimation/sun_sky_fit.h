@@ -34,6 +34,9 @@ struct Sample {
   glm::vec3 overcast{0.0f};  // irradiance per unit DHI of a uniform overcast sky
   bool sunlit = false;  // s·max(0, n·l) > 0: the direct sun reaches the point
   uint32_t pixel = 0;   // the camera pixel (row-major index into the bake's G-buffer)
+  // The model surface the pixel sees (the bake's camera surface map): a surface's samples share
+  // its departure from the model's sky (its albedo, the sky's shape toward its normal, gloss).
+  uint32_t surface = 0;
 };
 
 // What the model predicts for `s` under `light` with the overcast share `overcast_share`:
@@ -55,6 +58,25 @@ struct SunSkyFitOptions {
   double absent_sun_share = 0.05;   // below this share of the sunlit samples' light the sun counts
                                     // as absent (overcast): the split's conditioning is the sky's
   bool split_sky = true;            // fit E_clear and E_overcast apart (when the samples differ)
+  // E_sun from the shadows the sun casts within each surface, not from how surfaces of different
+  // orientation differ: each surface's sky light gets a gain of its own (a free factor on the
+  // fitted sky's radiance there), so only a surface's sunlit samples against its own shadowed
+  // ones tell the sun. How surfaces facing different ways differ rests on the sky's shape toward
+  // each, which a photographed or hazy sky, gloss or a wrong albedo bend by tens of percent; a
+  // cast shadow's edge on one surface rests on none of them. But where the model is right, the
+  // surfaces' differences are information too. So the gains say which it is: their relative
+  // spread s against `surface_model_error` m, what each surface's light is known to be off by in
+  // an exact model (per surface and stratum, truth over daylit, 0.966-1.013 on courtyard-a's clear
+  // frames: tests/transfer_truth_recording_test.cc), and E_sun = ρ·E_shadows + (1 − ρ)·E_scene
+  // with ρ = (1 − m²/s²)·D²/(D² + var) where s > m, else 0: D = E_shadows − E_scene, var what
+  // the shadows' estimate is unsure of, its samples' scatter and (m·E_shadows/share)², the model
+  // error passed on by the share of the sun's information it rests on (where the two differ by no
+  // more, the scene's fit, which knows more, is kept). Only where at least
+  // `min_shadow_information` of the sun's information comes from within the surfaces (the Schur
+  // complements' ratio).
+  bool sun_from_shadows = true;
+  double min_shadow_information = 0.05;
+  double surface_model_error = 0.02;
 
   // Empty when every field is in range, else the first problem, naming the field.
   std::string Check() const;
@@ -88,6 +110,14 @@ struct SunSkyFitSummary {
   // reflected from nearby walls.
   double sun_share_sunlit = 1.0;
   double sky_share_shadowed = 1.0;
+  // The share of the sun's information that comes from within the surfaces (their own shadows:
+  // SunSkyFitOptions::sun_from_shadows), worst channel over the channels whose surfaces' gains
+  // differ beyond the model's known error; 0 where none does (the scene's fit then stands and the
+  // shadows' estimate is not made), without sunlit samples or with one surface.
+  double shadow_information = 0.0;
+  // ρ of SunSkyFitOptions::sun_from_shadows, the mean over channels: 0 the whole scene's E_sun,
+  // 1 the shadows'.
+  double shadow_weight = 0.0;
   // With a sun colour given (FitSunSky), the light with E_sun of that colour: one magnitude from
   // the three channels, each weighed by what it knows of the sun (its normal equations' Schur
   // complement, the clear sky profiled out), and each channel's clear sky refitted with it. The
