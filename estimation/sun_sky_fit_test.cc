@@ -204,6 +204,18 @@ std::vector<Sample> SurfaceSamples(const std::array<double, 5>& sky_factor, std:
   return samples;
 }
 
+// The fits of SurfaceSamples(sky_factor) without the shadows' E_sun (the scene's) and with it.
+struct SceneAndShadowFits {
+  SunSkyFitSummary scene, fit;
+};
+SceneAndShadowFits FitSurfaceSamples(const std::array<double, 5>& sky_factor, unsigned seed) {
+  std::mt19937 rng(seed);
+  const std::vector<Sample> samples = SurfaceSamples(sky_factor, rng);
+  SunSkyFitOptions scene_only;
+  scene_only.sun_from_shadows = false;
+  return {FitSunSky(scene_only, samples), FitSunSky({}, samples)};
+}
+
 // The sky 50% brighter than the model's on the shaded surface: the whole scene's fit takes that for
 // sky everywhere, the sunlit samples' sky part grows, and E_sun reads 5-10% low. The other
 // surfaces' own shadows say what the sun is, whatever the sky; the gains, far apart beyond the
@@ -211,12 +223,7 @@ std::vector<Sample> SurfaceSamples(const std::array<double, 5>& sky_factor, std:
 // of the sun, so their estimate is weighed by what that share passes on of the model's error
 // (measured: ρ 0.60, E_sun −4.7 / −6.2 / −10.1% → −2.6 / −2.6 / −2.2%).
 TEST(SunSkyFitTest, TheSurfacesOwnShadowsTellTheSunWhereTheSkyIsOffBySurface) {
-  std::mt19937 rng(23);
-  const std::vector<Sample> samples = SurfaceSamples({1.0, 1.0, 1.5, 1.0, 1.0}, rng);
-  SunSkyFitOptions scene_only;
-  scene_only.sun_from_shadows = false;
-  const SunSkyFitSummary scene = FitSunSky(scene_only, samples);
-  const SunSkyFitSummary fit = FitSunSky({}, samples);
+  const auto [scene, fit] = FitSurfaceSamples({1.0, 1.0, 1.5, 1.0, 1.0}, 23);
   ASSERT_TRUE(scene.IsUsable() && fit.IsUsable());
   for (int c = 0; c < 3; ++c) {
     const double scene_error = scene.light.sun_rgb[c] / kClear.sun_rgb[c] - 1.0, error = fit.light.sun_rgb[c] / kClear.sun_rgb[c] - 1.0;
@@ -232,12 +239,7 @@ TEST(SunSkyFitTest, TheSurfacesOwnShadowsTellTheSunWhereTheSkyIsOffBySurface) {
 // Where the model is right (every surface's sky within 1% of it) the surfaces' differences are
 // information, and the whole scene's fit is kept as it is.
 TEST(SunSkyFitTest, WhereTheSurfacesAgreeTheScenesFitIsKept) {
-  std::mt19937 rng(29);
-  const std::vector<Sample> samples = SurfaceSamples({1.01, 0.995, 1.0, 0.99, 1.005}, rng);
-  SunSkyFitOptions scene_only;
-  scene_only.sun_from_shadows = false;
-  const SunSkyFitSummary scene = FitSunSky(scene_only, samples);
-  const SunSkyFitSummary fit = FitSunSky({}, samples);
+  const auto [scene, fit] = FitSurfaceSamples({1.01, 0.995, 1.0, 0.99, 1.005}, 29);
   ASSERT_TRUE(scene.IsUsable() && fit.IsUsable());
   EXPECT_EQ(fit.shadow_weight, 0.0);
   for (int c = 0; c < 3; ++c) {
