@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <stdexcept>
 #include <map>
 
 #include <glm/gtc/constants.hpp>
@@ -248,8 +249,15 @@ Mesh LoadGltfMesh(const std::filesystem::path& path, const std::filesystem::path
   GltfFiles files{root.empty() ? root : std::filesystem::absolute(root).lexically_normal(), {}};
   loader.SetFsCallbacks({&GltfFiles::Exists, &GltfFiles::Expand, &GltfFiles::Read, &GltfFiles::Write, &files});
   std::string error, warning;
-  const bool ok = path.extension() == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, path.string())
-                                             : loader.LoadASCIIFromFile(&model, &error, &warning, path.string());
+  bool ok = false;
+  try {
+    ok = path.extension() == ".glb" ? loader.LoadBinaryFromFile(&model, &error, &warning, path.string())
+                                    : loader.LoadASCIIFromFile(&model, &error, &warning, path.string());
+  } catch (const std::out_of_range& e) {
+    // tinygltf indexes some of the file's own lists with at(): a .glb whose buffer has byteLength
+    // 0 and no binary chunk asked for element 0 of an empty one (fuzz_gltf).
+    ThrowInputError("{}: not a glTF 2.0 file (an index past one of its lists: {})", path.string(), e.what());
+  }
   if (!files.refused.empty()) {
     ThrowInputError("{}: names '{}', outside the recording folder {} (daylit --allow-outside-paths allows it)", path.string(),
                     files.refused, files.root.string());
