@@ -28,6 +28,17 @@ struct NormalEquations {
   double yy = 0.0;
 };
 
+// What a channel's normal equations know of its sun with the clear sky profiled out: the Schur
+// complement A_ss − A_sc²/A_cc (information) and b_s − A_sc·b_c/A_cc (numerator; E_sun = their
+// ratio). Without a clear sky's information, A_ss and b_s.
+struct ProfiledSun {
+  double numerator = 0.0, information = 0.0;
+};
+ProfiledSun ProfileSun(const NormalEquations& eq) {
+  if (!(eq.a[1][1] > 0.0)) return {eq.b[0], eq.a[0][0]};
+  return {eq.b[0] - eq.a[0][1] * eq.b[1] / eq.a[1][1], eq.a[0][0] - eq.a[0][1] * eq.a[0][1] / eq.a[1][1]};
+}
+
 // The least-squares E ≥ 0 over the unknowns in `free` (the others stay 0): every subset of them is
 // solved and the best feasible one wins (three unknowns at most: seven subsets, each a 3×3 solve).
 ChannelFit SolveNonNegative(const NormalEquations& eq, const std::array<bool, 3>& free) {
@@ -150,7 +161,7 @@ class ChannelFitter {
   // The normal equations at the last fit's final weights (for the channel it was loaded with).
   NormalEquations FinalEquations() { return Equations(); }
 
-  // After a fit without the split (`fit`, over `rows`): E_sun as each surface's own shadows show
+  // After a fit without the split (`fit`) and PrepareSurfaces: E_sun as each surface's own shadows show
   // it (SunSkyFitOptions::sun_from_shadows). y ≈ E_sun·x_sun + g_s·L_sky with L_sky the fitted
   // sky's radiance at the sample and g_s a gain per surface s, profiled out: with per-surface sums
   // S_ll = Σ w L², S_xl = Σ w x L, S_ly = Σ w L y,
@@ -197,8 +208,7 @@ class ChannelFitter {
   WithinSurfaces SunWithinSurfaces(const ChannelFit& fit, const NormalEquations& equations) {
     WithinSurfaces out;
     // The whole scene's information on the sun, its clear sky profiled out, at the same weights.
-    out.scene_information = equations.a[1][1] > 0.0 ? equations.a[0][0] - equations.a[0][1] * equations.a[0][1] / equations.a[1][1]
-                                                    : equations.a[0][0];
+    out.scene_information = ProfileSun(equations).information;
     const uint32_t surfaces = surfaces_;
     gain_.assign(surfaces, 1.0);
     sums_.resize(surfaces);
@@ -246,7 +256,7 @@ class ChannelFitter {
   // fit stands (FitSunSky's ρ is 0) and the shadows' estimate is not needed.
   double GainSpreadAt(const ChannelFit& fit) {
     const uint32_t surfaces = surfaces_;
-    gain_.assign(surfaces, 1.0);
+    gain_.resize(surfaces);
     sums_.assign(surfaces, Sums{});
     for (size_t k = 0; k < m_; ++k) {
       const double x = x_[0][k], l = offset_[k] + x_[1][k] * fit[1] + x_[2][k] * fit[2], w = w_[k];
@@ -392,8 +402,7 @@ class ChannelFitter {
   const bool with_sun_;
   static constexpr uint32_t kMaxSurfaces = 1u << 16;
   std::vector<double> y_, w_, relative_, scratch_, offset_, rest_;  // rest_: y_ less offset_
-  // SunWithinSurfaces' buffers: each row's surface and fitted sky radiance, each surface's gain
-  // and sums.
+  // SunWithinSurfaces' buffers: each row's surface, each surface's gain and sums.
   using Sums = std::array<double, 7>;
   std::vector<uint32_t> surface_of_row_;
   std::vector<uint8_t> casting_;  // per surface: it has both strata
@@ -522,7 +531,6 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   bool several_surfaces = false;
   for (const size_t i : usable) several_surfaces = several_surfaces || samples[i].surface != samples[usable[0]].surface;
   const bool from_shadows = options.sun_from_shadows && with_sun && several_surfaces;
-  std::array<ChannelFitter::WithinSurfaces, 3> within{};
   if (from_shadows) fitter.PrepareSurfaces(usable);
   std::array<double, 3> shadow_weight{0.0, 0.0, 0.0}, mixed_information{0.0, 0.0, 0.0}, mixed_sun{0.0, 0.0, 0.0};
   double shadow_information = 1.0;  // worst channel, over those where it was needed
@@ -540,7 +548,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
     if (sun_colour != nullptr) equations = fitter.FinalEquations();
     if (from_shadows && fitter.GainSpreadAt(fit) > options.surface_model_error) {
       if (sun_colour == nullptr) equations = fitter.FinalEquations();
-      const ChannelFitter::WithinSurfaces& w = within[static_cast<size_t>(c)] = fitter.SunWithinSurfaces(fit, equations);
+      const ChannelFitter::WithinSurfaces w = fitter.SunWithinSurfaces(fit, equations);
       const double share = w.scene_information > 0.0 ? std::clamp(w.information / w.scene_information, 0.0, 1.0) : 0.0;
       shadow_information = std::min(shadow_information, share), shadows_measured = true;
       // The shadows' weight: none while the surfaces' gains differ by no more than their known
@@ -593,8 +601,8 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
         continue;
       }
       if (!(eq.a[1][1] > 0.0)) continue;
-      num += colour * (eq.b[0] - eq.a[0][1] * eq.b[1] / eq.a[1][1]);
-      den += colour * colour * (eq.a[0][0] - eq.a[0][1] * eq.a[0][1] / eq.a[1][1]);
+      const ProfiledSun profiled = ProfileSun(eq);
+      num += colour * profiled.numerator, den += colour * colour * profiled.information;
     }
     if (den > 0.0) {
       const double magnitude = std::max(0.0, num / den);

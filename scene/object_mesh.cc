@@ -5,8 +5,8 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
-#include <stdexcept>
 #include <map>
+#include <stdexcept>
 
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
