@@ -234,10 +234,23 @@ LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFit
   out.sky = glm::min(options.z * glm::sqrt(sky * sky + shape.sky * shape.sky), glm::dvec3(options.max_half_width));
   out.sun_observed = strata.lit_n > 0.0 && glm::compMin(s) >= fit_options.absent_sun_share;
   if (out.sun_observed) {
-    const glm::dvec3 sun = sensitivity.known
-                               ? glm::sqrt(glm::pow(sensitivity.sun * shadowed_delta, glm::dvec3(2.0)) +
-                                           glm::pow((1.0 - sensitivity.sun) * lit_error.error, glm::dvec3(2.0)))
-                               : glm::sqrt(glm::pow(lit_error.error / s, glm::dvec3(2.0)) + glm::pow((1.0 - s) / s * sky, glm::dvec3(2.0)));
+    glm::dvec3 sun = sensitivity.known
+                         ? glm::sqrt(glm::pow(sensitivity.sun * shadowed_delta, glm::dvec3(2.0)) +
+                                     glm::pow((1.0 - sensitivity.sun) * lit_error.error, glm::dvec3(2.0)))
+                         : glm::sqrt(glm::pow(lit_error.error / s, glm::dvec3(2.0)) + glm::pow((1.0 - s) / s * sky, glm::dvec3(2.0)));
+    // Where E_sun is partly the shadows' (ρ·E_shadows + (1 − ρ)·E_scene), the surfaces'
+    // disagreement above describes the scene's estimate only; the two mixed as the estimates are: the
+    // variance of a model average, ρ·e_shadows² + (1 − ρ)·e_scene² + ρ(1 − ρ)·D². With under two
+    // casting surfaces nothing shows how far the shadows' estimate is off, and it is taken as unsure
+    // as the scene's.
+    const SunSkyFitSummary::ShadowSun& shadows = fit.shadow_sun;
+    for (int c = 0; c < 3; ++c) {
+      const double rho = shadows.weight[c];
+      if (!(rho > 0.0)) continue;
+      const double own = shadows.casting_surfaces >= 2 ? shadows.error[c] : std::max(shadows.error[c], sun[c]);
+      const double d = shadows.difference[c];
+      sun[c] = std::sqrt(rho * own * own + (1.0 - rho) * sun[c] * sun[c] + rho * (1.0 - rho) * d * d);
+    }
     out.sun = glm::min(options.z * glm::sqrt(sun * sun + shape.sun * shape.sun), glm::dvec3(options.max_half_width));
   } else {
     out.sun = glm::dvec3(options.max_half_width);

@@ -94,7 +94,10 @@ struct LightInterval {
 //   e_sky² = (k_sky · δ_shadowed)² + ((1 − k_sky) · δ_sunlit)²,  e_sun² = (k_sun · δ_shadowed)² + ((1 − k_sun) · δ_sunlit)²
 //
 // else by the shares s and q of the file's header, as if E_sky were measured by the shadowed
-// samples alone and E_sun by the sunlit ones given E_sky.
+// samples alone and E_sun by the sunlit ones given E_sky. Where E_sun came partly from the
+// surfaces' own shadows (fit.shadow_sun: E_sun = ρ·E_shadows + (1 − ρ)·E_scene), the surfaces'
+// disagreement describes the scene's estimate only, and the two are mixed as a model average is:
+// e_sun² = ρ·e_shadows² + (1 − ρ)·e_scene² + ρ(1 − ρ)·D², D their relative difference.
 LightInterval IntervalOfFit(const LightIntervalOptions& options, const SunSkyFitOptions& fit_options,
                             const std::vector<Sample>& samples, const SunSkyFitSummary& fit,
                             const std::vector<uint32_t>& surface_of_pixel, const SkyShapeSpread& shape = {},

@@ -177,6 +177,11 @@ class ChannelFitter {
     // The variance of `sun` from the samples' scatter: the weighted mean square residual (relative,
     // at Reweight's weights) over the information.
     double variance = 0.0;
+    // How far the casting surfaces disagree on the sun: each one's own estimate (its sums alone,
+    // its gain profiled out), their relative standard deviation about `sun` (weighted by each one's
+    // information, × K/(K − 1) in variance), and K. Under two casting surfaces nothing shows it.
+    double sun_spread = 0.0;
+    int casting_surfaces = 0;
   };
   // Before SunWithinSurfaces, once for all channels: each of `rows`' surface, and which surfaces
   // tell the sun by their own shadow: those with both sunlit and shadowed samples,
@@ -248,7 +253,23 @@ class ChannelFitter {
     }
     out.sun = sun;
     out.gain_spread = GainSpread(surfaces);
+    SunSpread(surfaces, &out);
     return out;
+  }
+
+  // WithinSurfaces' sun_spread and casting_surfaces from the last pass's sums.
+  void SunSpread(uint32_t surfaces, WithinSurfaces* out) const {
+    double weight = 0.0, sum_sq = 0.0, k = 0.0;
+    for (uint32_t j = 0; j < surfaces; ++j) {
+      const Sums& s = sums_[j];
+      if (!casting_[j] || !(s[0] > 0.0)) continue;
+      const double information = s[3] - s[1] * s[1] / s[0];
+      if (!(information > 0.0)) continue;
+      const double own = (s[4] - s[1] * s[2] / s[0]) / information;
+      weight += information, sum_sq += information * (own - out->sun) * (own - out->sun), k += 1.0;
+    }
+    out->casting_surfaces = static_cast<int>(k);
+    if (k >= 2.0 && out->sun > 0.0) out->sun_spread = std::sqrt(sum_sq / weight * k / (k - 1.0)) / out->sun;
   }
 
   // After a fit without the split (`fit`), before SunWithinSurfaces: the gains' spread (GainSpread)
@@ -568,6 +589,13 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
       if (rho > 0.0) {
         // The clear sky follows the sun at the fit's final weights.
         const double sun = rho * w.sun + (1.0 - rho) * fit[0];
+        if (sun > 0.0) {  // relative to the sun given
+          const double least = std::max(w.sun_spread * w.sun, model) / sun;
+          summary.shadow_sun.weight[c] = rho;
+          summary.shadow_sun.error[c] = std::sqrt(least * least + w.variance / (sun * sun));
+          summary.shadow_sun.difference[c] = difference / sun;
+        }
+        summary.shadow_sun.casting_surfaces = w.casting_surfaces;
         const double clear = equations.a[1][1] > 0.0 ? std::max(0.0, (equations.b[1] - equations.a[0][1] * sun) / equations.a[1][1]) : fit[1];
         summary.light.sun_rgb[c] = sun;
         summary.light.sky_rgb[c] = clear + overcast;

@@ -118,6 +118,18 @@ struct SunSkyFitSummary {
   // ρ of SunSkyFitOptions::sun_from_shadows, the mean over channels: 0 the whole scene's E_sun,
   // 1 the shadows'.
   double shadow_weight = 0.0;
+  // Per channel, where the shadows' estimate was made (0 elsewhere): its ρ; how sure it is, its
+  // relative standard error: the casting surfaces' disagreement on the sun (WithinSurfaces'
+  // sun_spread; not over √K: what misleads one surface's shadow, gloss, clutter, often misleads
+  // the others alike), at least the model error m passed on by the share of the information it
+  // holds, m/share, and its samples' scatter added in quadrature; how many surfaces cast shadows
+  // (under two, the spread is unseen); and its difference from the scene's fit, relative to the
+  // sun it gave. LightInterval reads them.
+  struct ShadowSun {
+    glm::dvec3 weight{0.0}, error{0.0}, difference{0.0};
+    int casting_surfaces = 0;
+  };
+  ShadowSun shadow_sun;
   // With a sun colour given (FitSunSky), the light with E_sun of that colour: one magnitude from
   // the three channels, each weighed by what it knows of the sun (its normal equations' Schur
   // complement, the clear sky profiled out), and each channel's clear sky refitted with it. The

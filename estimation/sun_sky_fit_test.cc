@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -10,6 +11,8 @@
 
 #include <glm/gtc/constants.hpp>
 #include <glm/gtx/component_wise.hpp>
+
+#include "estimation/testing/surface_samples.h"
 
 namespace daylit::estimation {
 namespace {
@@ -176,41 +179,13 @@ TEST(SunSkyFitTest, OneSampleLessMovesTheEstimateByLittle) {
   }
 }
 
-// Five planar surfaces, each seeing about the same sky all over: the first and last all sunlit
-// (facing the sun at cosines 0.9 and 0.3), the second partly in a cast shadow (0.6), the third and
-// fourth all in shade. The sky reaching each differs from the model's by a factor of its own,
-// `sky_factor` (a photographed sky unlike the captured one, a wrong albedo). Pixel noise 1%.
-std::vector<Sample> SurfaceSamples(const std::array<double, 5>& sky_factor, std::mt19937& rng) {
-  const std::array<float, 5> cosine{0.9f, 0.75f, 0.6f, 0.45f, 0.3f};
-  const std::array<float, 5> visibility{0.5f, 0.6f, 0.55f, 0.6f, 0.5f};  // a wall sees the same sky all over
-  std::uniform_real_distribution<float> albedo(0.2f, 0.6f), v(0.0f, 0.05f), pick(0, 1), bounce(0.0f, 0.1f);
-  std::normal_distribution<float> noise(0.0f, 0.01f);
-  std::vector<Sample> samples(5000);
-  for (size_t i = 0; i < samples.size(); ++i) {
-    Sample& s = samples[i];
-    s.surface = static_cast<uint32_t>(i % 5);
-    s.pixel = static_cast<uint32_t>(i);
-    s.albedo = glm::vec3(albedo(rng));
-    s.sunlit = s.surface == 0 || s.surface == 4 || (s.surface != 2 && pick(rng) >= 0.4f);
-    s.sun = glm::vec3((s.sunlit ? cosine[s.surface] : 0.0f) + bounce(rng));
-    s.sky = glm::vec3(visibility[s.surface] + v(rng));
-    s.overcast = s.sky;
-    const float n = 1.0f + noise(rng);
-    for (int c = 0; c < 3; ++c) {
-      s.radiance[c] = n * static_cast<float>(s.albedo[c] / glm::pi<double>() *
-                                             (s.sun[c] * kClear.sun_rgb[c] + sky_factor[s.surface] * s.sky[c] * kClear.sky_rgb[c]));
-    }
-  }
-  return samples;
-}
-
 // The fits of SurfaceSamples(sky_factor) without the shadows' E_sun (the scene's) and with it.
 struct SceneAndShadowFits {
   SunSkyFitSummary scene, fit;
 };
 SceneAndShadowFits FitSurfaceSamples(const std::array<double, 5>& sky_factor, unsigned seed) {
   std::mt19937 rng(seed);
-  const std::vector<Sample> samples = SurfaceSamples(sky_factor, rng);
+  const std::vector<Sample> samples = testing::SurfaceSamples(kClear, sky_factor, rng);
   SunSkyFitOptions scene_only;
   scene_only.sun_from_shadows = false;
   return {FitSunSky(scene_only, samples), FitSunSky({}, samples)};

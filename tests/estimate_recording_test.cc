@@ -4,6 +4,7 @@
 // the bake, sun from the ephemeris, sampler with transfer terms, fit, temporal filter.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -71,6 +72,8 @@ void ExpectPerBurst(const testing::BundledCourtyard& c, double p90_bar, double a
       testing::RecordFigure(fmt::format("{}/estimate/burst{}/sun_error/{}", c.scene.name, b.burst.index, "rgb"[ch]), b.sun_error[ch]);
       testing::RecordFigure(fmt::format("{}/estimate/burst{}/sky_error/{}", c.scene.name, b.burst.index, "rgb"[ch]), b.sky_error[ch]);
     }
+    // Issue 51: the 90% interval, made from the frames alone, holds the burst's errors.
+    EXPECT_TRUE(b.interval_covers) << c.scene.name << " burst " << b.burst.index;
   }
   testing::RecordFigure(c.scene.name + "/estimate/p90_worst_channel", truth.p90_worst_channel_error);
   // Issue 37: no more than 5% of the frames more than 10% off.
@@ -105,6 +108,35 @@ TEST(EstimateRecordingTest, CourtyardCEveryBurstWithin5Percent) {
   // Measured: worst 1.7% (burst 2's E_sun green), the 90th percentile 4.6%, and no frame is over
   // 10%: the confidence has nothing to rank (when one is, the issue's bar holds).
   ExpectPerBurst(testing::CourtyardC(), 0.10, 0.90);
+}
+
+// Issue 51 on the realistic recording: its surfaces disagree by 4-12%, and the 90% interval, made
+// from the frames alone, holds every burst's errors (E_sun up to 17.5%, E_sky up to 10.7%). Where
+// E_sun comes from the surfaces' own shadows, the interval is theirs, not the scene's fit's, which
+// those surfaces' disagreement describes (measured: E_sun's median half-width over bursts 34.3%,
+// 59.6% with the scene's alone; E_sky's 20.7%). The bars: the errors it must hold, and an interval
+// no wider than half again what it is.
+TEST(EstimateRecordingTest, CourtyardEsIntervalHoldsEveryBurstAndIsTheShadowsWhereTheyTellTheSun) {
+  const testing::BundledCourtyard& c = testing::CourtyardE();
+  const scene::RayCaster caster(c.scene.model);
+  pipeline::LightingPipeline lighting(c.scene, c.bake, caster, {});
+  const pipeline::PipelineRun run = lighting.Run(scene::OpenFrameSource(c.scene));
+  ASSERT_TRUE(c.scene.groundtruth.lighting.has_value());
+  const evaluation::TruthComparison truth = evaluation::CompareWithTruth(run.frames, *c.scene.groundtruth.lighting);
+  const std::vector<evaluation::BurstLighting> bursts = evaluation::CompareBursts(run.frames, &truth);
+  ASSERT_EQ(bursts.size(), 5u);
+  std::vector<double> sun_widths, sky_widths;
+  for (const evaluation::BurstLighting& b : bursts) {
+    EXPECT_TRUE(b.interval_covers) << "burst " << b.burst.index;
+    sun_widths.push_back((b.sun_half_width.x + b.sun_half_width.y + b.sun_half_width.z) / 3.0);
+    sky_widths.push_back((b.sky_half_width.x + b.sky_half_width.y + b.sky_half_width.z) / 3.0);
+  }
+  std::sort(sun_widths.begin(), sun_widths.end());
+  std::sort(sky_widths.begin(), sky_widths.end());
+  testing::RecordFigure("courtyard-e/estimate/sun_half_width_median", sun_widths[2]);
+  testing::RecordFigure("courtyard-e/estimate/sky_half_width_median", sky_widths[2]);
+  EXPECT_LT(sun_widths[2], 0.5);
+  EXPECT_LT(sky_widths[2], 0.3);
 }
 
 TEST(EstimateRecordingTest, EveryDiffuseSurfaceInShadeIsSaidNotNaN) {
