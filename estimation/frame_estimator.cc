@@ -110,6 +110,7 @@ FrameLight FrameEstimator::Estimate(const capture::Frame& frame, const scene::Tr
   out.row.sunlit_samples = out.fit.sunlit_samples;
   out.row.shadowed_samples = out.fit.shadowed_samples;
   out.row.sun_up = out.fit.sun_up;
+  out.row.status = FrameStatusOfFit(out.fit.status);
   return out;
 }
 
@@ -117,6 +118,7 @@ FrameLight FrameEstimator::Hold(const capture::Frame& frame, const scene::Tracke
   FrameLight out;
   out.row = Row(frame, sun);
   out.row.decoded = false;
+  out.row.status = FrameStatus::kUnreadable;
   const FilteredLight held = filter_.Update(SecondsSinceFirst(frame.utc), std::nullopt, 0.0);
   out.row.light = held.light;
   out.row.confidence = held.confidence;
@@ -126,17 +128,39 @@ FrameLight FrameEstimator::Hold(const capture::Frame& frame, const scene::Tracke
   return out;
 }
 
+const char* FrameStatusName(FrameStatus status) {
+  switch (status) {
+    case FrameStatus::kConverged: return "converged";
+    case FrameStatus::kSkyOnly: return "sky_only";
+    case FrameStatus::kNotConverged: return "not_converged";
+    case FrameStatus::kTooFewSamples: return "too_few_samples";
+    case FrameStatus::kUnreadable: return "unreadable";
+  }
+  return "unknown";
+}
+
+FrameStatus FrameStatusOfFit(SunSkyFitStatus status) {
+  switch (status) {
+    case SunSkyFitStatus::kConverged: return FrameStatus::kConverged;
+    case SunSkyFitStatus::kSkyOnly: return FrameStatus::kSkyOnly;
+    case SunSkyFitStatus::kNoConvergence: return FrameStatus::kNotConverged;
+    case SunSkyFitStatus::kTooFewSamples: return FrameStatus::kTooFewSamples;
+  }
+  return FrameStatus::kTooFewSamples;
+}
+
 std::string EstimatesCsv(const std::vector<FrameEstimate>& frames) {
   fmt::memory_buffer out;
   fmt::format_to(std::back_inserter(out), "frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,"
-                                          "sky_g,sky_b,confidence,samples,{}\n",
+                                          "sky_g,sky_b,confidence,samples,{},status\n",
                  IntervalCsvHeader());
   for (const FrameEstimate& f : frames) {
     fmt::format_to(std::back_inserter(out), "{},{},{:.4f},{:.4f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{}",
                    f.frame, FormatUtcTime(f.time_utc), f.sun_elevation_deg, f.sun_azimuth_deg, f.light.sun_rgb.x,
                    f.light.sun_rgb.y, f.light.sun_rgb.z, f.light.sky_rgb.x, f.light.sky_rgb.y, f.light.sky_rgb.z,
                    f.confidence, f.samples);
-    fmt::format_to(std::back_inserter(out), "{}\n", IntervalCsvFields(BoundsOf(f.light, f.interval)));
+    fmt::format_to(std::back_inserter(out), "{},{}\n", IntervalCsvFields(BoundsOf(f.light, f.interval)),
+                   FrameStatusName(f.status));
   }
   return fmt::to_string(out);
 }

@@ -30,6 +30,21 @@ struct FrameEstimatorOptions {
   std::string Check() const;
 };
 
+// What became of one frame, in estimates.csv's `status` column (FrameStatusName). The light of a
+// frame whose status is not IsFitted is the filter's held estimate of the frames before it.
+enum class FrameStatus {
+  kConverged,      // fitted
+  kSkyOnly,        // fitted, E_sky alone: no sunlit sample (sun below the horizon or all in shadow)
+  kNotConverged,   // fitted, the reweighting still moving after its iterations: the last iterate
+  kTooFewSamples,  // fewer than 10 usable samples: not fitted, the estimate held
+  kUnreadable,     // the frame could not be read (decoded): not fitted, the estimate held
+};
+const char* FrameStatusName(FrameStatus status);  // "converged", "sky_only", ... as in the CSV
+FrameStatus FrameStatusOfFit(SunSkyFitStatus status);
+inline bool IsFitted(FrameStatus status) {
+  return status != FrameStatus::kTooFewSamples && status != FrameStatus::kUnreadable;
+}
+
 // One row of estimates.csv.
 struct FrameEstimate {
   int frame = 0;
@@ -47,6 +62,7 @@ struct FrameEstimate {
   int sunlit_samples = 0, shadowed_samples = 0;
   bool sun_up = false;
   bool decoded = true;             // false: the frame could not be decoded (the estimate holds)
+  FrameStatus status = FrameStatus::kTooFewSamples;
 
   // False until the first usable fit: the light is all zero before it.
   bool HasEstimate() const { return light.sky_rgb.x + light.sky_rgb.y + light.sky_rgb.z > 0.0; }
@@ -99,7 +115,8 @@ class FrameEstimator {
 };
 
 // The stable CSV: frame,time_utc,sun_elevation_deg,sun_azimuth_deg,sun_r,sun_g,sun_b,sky_r,sky_g,
-// sky_b,confidence,samples.
+// sky_b,confidence,samples, the interval's bounds (IntervalCsvHeader), status (FrameStatusName).
+// Columns are only ever added at the end.
 std::string EstimatesCsv(const std::vector<FrameEstimate>& frames);
 
 }  // namespace daylit::estimation

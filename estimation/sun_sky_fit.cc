@@ -444,7 +444,7 @@ class ChannelFitter {
 // a small model error in one channel trade sun for sky there. Also returns each channel's split
 // fit in `split_fits`.
 double PooledOvercast(ChannelFitter* fitter, const std::vector<Sample>& samples, const std::vector<size_t>& usable,
-                      std::array<ChannelFit, 3>* split_fits) {
+                      std::array<ChannelFit, 3>* split_fits, int* unconverged) {
   const std::vector<uint8_t> half = FixedSubset(samples, 2, true);
   std::vector<size_t> every_other;
   for (const size_t i : usable) {
@@ -454,6 +454,7 @@ double PooledOvercast(ChannelFitter* fitter, const std::vector<Sample>& samples,
   for (int c = 0; c < 3; ++c) {
     ChannelFit& fit = (*split_fits)[static_cast<size_t>(c)];
     fit = fitter->Fit(c, true, 0.0, nullptr, every_other);
+    *unconverged += fitter->converged() ? 0 : 1;
     overcast += fit[2] / 3.0;
   }
   return overcast;
@@ -540,10 +541,13 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   for (const size_t i : usable) two_skies = two_skies || (options.split_sky && samples[i].sky != samples[i].overcast);
   ChannelFitter fitter(options, samples, n, with_sun);
   std::array<ChannelFit, 3> split_fits{};
-  const double overcast = two_skies ? PooledOvercast(&fitter, samples, usable, &split_fits) : 0.0;
+  // The fits that ran out of IRLS iterations: the split ones (whose overcast part every channel's
+  // final fit takes) and the final ones.
+  int unconverged_fits = 0, fits = 3;
+  const double overcast = two_skies ? PooledOvercast(&fitter, samples, usable, &split_fits, &unconverged_fits) : 0.0;
+  fits += two_skies ? 3 : 0;
   // Each channel fitted again with the pooled overcast part given, starting from its split fit's
   // sun and clear sky.
-  int unconverged_channels = 0;  // final fits that ran out of IRLS iterations
   std::vector<double> spreads, all_residuals, scratch;
   all_residuals.reserve(3 * n);
   std::array<NormalEquations, 3> final_equations{};
@@ -560,7 +564,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
     const ChannelFit& split = split_fits[static_cast<size_t>(c)];
     const ChannelFit start{split[0], split[1], 0.0};
     const ChannelFit fit = fitter.Fit(c, false, overcast, two_skies ? &start : nullptr, usable);
-    unconverged_channels += fitter.converged() ? 0 : 1;
+    unconverged_fits += fitter.converged() ? 0 : 1;
     summary.light.sun_rgb[c] = fit[0];
     summary.light.sky_rgb[c] = fit[1] + overcast;
     // The normal equations at the final weights: for a sun of given colour, and for the clear sky
@@ -655,7 +659,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   summary.inlier_share = static_cast<double>(inliers) / static_cast<double>(all_residuals.size());
   SplitShares(options, samples, usable, &summary);
   summary.confidence = Confidence(options, summary, with_sun);
-  summary.status = unconverged_channels > 0 ? SunSkyFitStatus::kNoConvergence
+  summary.status = unconverged_fits > 0 ? SunSkyFitStatus::kNoConvergence
                    : with_sun                ? SunSkyFitStatus::kConverged
                                              : SunSkyFitStatus::kSkyOnly;
   summary.own = summary.light;
@@ -663,9 +667,9 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
                                 summary.sunlit_samples, summary.shadowed_samples,
                                 summary.sun_up && !with_sun ? ": the sun is up but reaches none, E_sun not observed" : "",
                                 summary.residual_spread,
-                                unconverged_channels > 0
-                                    ? fmt::format("; {} of 3 channels still moving after {} iterations",
-                                                  unconverged_channels, options.iterations)
+                                unconverged_fits > 0
+                                    ? fmt::format("; {} of {} channel fits still moving after {} iterations",
+                                                  unconverged_fits, fits, options.iterations)
                                     : std::string());
   return summary;
 }

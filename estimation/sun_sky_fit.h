@@ -86,7 +86,8 @@ enum class SunSkyFitStatus {
   kConverged,
   kSkyOnly,         // no sunlit samples (sun below the horizon or every sample shadowed): E_sun = 0
   kNoConvergence,   // the reweighting ran out of `iterations` with the estimate still moving by more
-                    // than its tolerance in some channel: usable, the last iterate
+                    // than its tolerance in some channel's fit (the split one whose overcast part
+                    // the final ones take, or a final one): usable, the last iterate
   kTooFewSamples,   // fewer than 10 usable samples: nothing fitted
 };
 

@@ -323,12 +323,37 @@ void ReportBursts(const std::vector<BurstLighting>& bursts, const std::filesyste
   report->Figure("lighting/bursts", static_cast<double>(bursts.size()));
 }
 
+// How many frames were fitted and how (estimation::FrameStatus), as one report line and figures
+// (lighting/frames_<status>, lighting/frames_held): what estimates.csv's status column says, counted.
+void ReportFrameStatus(const std::vector<estimation::FrameEstimate>& frames, RunReport* report) {
+  using estimation::FrameStatus;
+  constexpr std::array<FrameStatus, 5> kAll{FrameStatus::kConverged, FrameStatus::kSkyOnly, FrameStatus::kNotConverged,
+                                            FrameStatus::kTooFewSamples, FrameStatus::kUnreadable};
+  std::array<int, kAll.size()> count{};
+  for (const estimation::FrameEstimate& f : frames) ++count[static_cast<size_t>(f.status)];
+  std::string parts;
+  int held = 0;
+  for (size_t k = 0; k < kAll.size(); ++k) {
+    report->Figure(fmt::format("lighting/frames_{}", estimation::FrameStatusName(kAll[k])), count[k]);
+    if (!estimation::IsFitted(kAll[k])) held += count[k];
+    if (count[k] > 0) parts += fmt::format("{}{} {}", parts.empty() ? "" : ", ", count[k], estimation::FrameStatusName(kAll[k]));
+  }
+  report->Figure("lighting/frames_held", held);
+  const int not_converged = count[static_cast<size_t>(FrameStatus::kNotConverged)];
+  report->Say(fmt::format("frames by fit status (estimates.csv's status): {}{}{}", parts.empty() ? "none" : parts,
+                          held > 0 ? fmt::format("; {} not fitted, each holding the estimate before it", held) : "",
+                          not_converged > 0 ? fmt::format("; {} fitted with the reweighting still moving (the last iterate)",
+                                                          not_converged)
+                                            : ""));
+}
+
 }  // namespace
 
 std::optional<TruthComparison> ReportLighting(const scene::Scene& scene, const std::vector<estimation::FrameEstimate>& frames,
                                               const std::filesystem::path& csv, const std::filesystem::path& png,
                                               RunReport* report) {
   WriteFileAtomically(csv, estimation::EstimatesCsv(frames));
+  ReportFrameStatus(frames, report);
   std::optional<TruthComparison> truth;
   if (scene.groundtruth.lighting) truth = CompareWithTruth(frames, *scene.groundtruth.lighting);
   ReportBursts(CompareBursts(frames, truth ? &*truth : nullptr), BurstsCsvPath(csv), report);

@@ -83,6 +83,7 @@ nlohmann::json LightingJson(const FrameLighting& l, const std::optional<glm::vec
       {"sunUp", r.sun_up},
       {"confidence", r.confidence},
       {"hasEstimate", r.HasEstimate()},
+      {"status", estimation::FrameStatusName(r.status)},
   };
   // The 90% intervals of E_sun and E_sky (estimation/light_interval.h), around the values above.
   const estimation::IntervalBounds bounds = estimation::BoundsOf(r.light, r.interval);

@@ -40,6 +40,7 @@ std::shared_ptr<FrameLighting> Frame(int index) {
   l->row.interval.sun = glm::dvec3(0.05);
   l->row.interval.sky = glm::dvec3(0.1);
   l->row.sun_up = true;
+  l->row.status = estimation::FrameStatus::kConverged;
   l->sun_scene = glm::normalize(glm::vec3(0.3f, -0.4f, 0.8f));
   l->sun_camera = glm::normalize(glm::vec3(0.1f, -0.9f, 0.2f));
   return l;
@@ -119,6 +120,7 @@ TEST(LightingServerTest, LightingIs503BeforeTheFirstFrameThenTheLatestWithWebXrN
   EXPECT_DOUBLE_EQ(j["primaryLightIntensityInterval90"]["hi"]["x"].get<double>(), 87.0 * 1.05);
   EXPECT_DOUBLE_EQ(j["skyIrradianceInterval90"]["lo"]["z"].get<double>(), 19.0 * 0.9);
   EXPECT_TRUE(j["primaryLightObserved"].get<bool>());
+  EXPECT_EQ(j["status"], "converged");
   const glm::vec3 sun = Frame(0)->sun_scene;
   EXPECT_NEAR(j["primaryLightDirection"]["y"].get<double>(), sun.y, 1e-6);
   EXPECT_TRUE(j["sphericalHarmonicsCoefficients"].is_null());  // no volume

@@ -239,7 +239,10 @@ TEST(CliTest, EstimateWritesTheStableCsv) {
                             " --figures " + figures.string());
   ASSERT_EQ(run.exit_code, 0) << run.err;
   std::ifstream figures_in(figures);
-  EXPECT_EQ(nlohmann::json::parse(figures_in).at("frames").get<int>(), 1);
+  const nlohmann::json figures_json = nlohmann::json::parse(figures_in);
+  EXPECT_EQ(figures_json.at("frames").get<int>(), 1);
+  EXPECT_EQ(figures_json.at("lighting/frames_sky_only").get<int>(), 1);
+  EXPECT_EQ(figures_json.at("lighting/frames_held").get<int>(), 0);
   // One frame, which moved the sun: no per-frame timing, said in words, not "nan ms" (issue 43).
   EXPECT_EQ(run.err.find("nan"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("not timed"), std::string::npos) << run.err;
@@ -251,8 +254,12 @@ TEST(CliTest, EstimateWritesTheStableCsv) {
   EXPECT_EQ(table.header, (std::vector<std::string>{"frame", "time_utc", "sun_elevation_deg", "sun_azimuth_deg", "sun_r",
                                                      "sun_g", "sun_b", "sky_r", "sky_g", "sky_b", "confidence", "samples",
                                                      "sun_r_lo", "sun_r_hi", "sun_g_lo", "sun_g_hi", "sun_b_lo", "sun_b_hi",
-                                                     "sky_r_lo", "sky_r_hi", "sky_g_lo", "sky_g_hi", "sky_b_lo", "sky_b_hi"}));
+                                                     "sky_r_lo", "sky_r_hi", "sky_g_lo", "sky_g_hi", "sky_b_lo", "sky_b_hi",
+                                                     "status"}));
   ASSERT_EQ(table.rows.size(), 1u);
+  // What became of the frame (issue 39): fitted, E_sky alone, and the report counts it.
+  EXPECT_EQ(table.rows[0][static_cast<size_t>(table.RequireColumn("status"))], "sky_only");
+  EXPECT_NE(run.out.find("frames by fit status (estimates.csv's status): 1 sky_only"), std::string::npos) << run.out;
   const double linear = capture::CameraResponse{}.ToLinear(120.0 / 255.0);
   const double sky = ParseFiniteDouble(table.rows[0][7], "sky_r");
   EXPECT_NEAR(sky, M_PI * linear / 0.4, 0.01 * M_PI * linear / 0.4);
@@ -331,9 +338,14 @@ TEST(CliTest, EstimateSkipsAFrameThatCannotBeDecodedAndGoesOn) {
   EXPECT_NE(run.err.find("1 frames could not be decoded"), std::string::npos) << run.err;
   const CsvTable table = ReadCsvFile(out);
   ASSERT_EQ(table.rows.size(), 3u);
-  // The skipped frame holds the estimate of the one before.
+  // The skipped frame holds the estimate of the one before, and says why.
   EXPECT_EQ(table.rows[1][7], table.rows[0][7]);
   EXPECT_EQ(table.rows[2][7], table.rows[0][7]);
+  const size_t status = static_cast<size_t>(table.RequireColumn("status"));
+  EXPECT_EQ(table.rows[0][status], "sky_only");
+  EXPECT_EQ(table.rows[1][status], "unreadable");
+  EXPECT_NE(run.out.find("2 sky_only, 1 unreadable; 1 not fitted, each holding the estimate before it"), std::string::npos)
+      << run.out;
 }
 
 TEST(CliTest, RelightEnvWritesTheRelitMapAndItsPreview) {
