@@ -17,7 +17,7 @@ namespace daylit::capture {
 
 class AsyncVideoWriter {
  public:
-  // Opens `path` (throws InputError as VideoEncoder does).
+  // Opens `path` (throws as VideoEncoder does).
   AsyncVideoWriter(const std::filesystem::path& path, int width, int height, double fps, const CameraResponse& response);
   // Without Finish (an error elsewhere) the queued frames are dropped; the caller removes the file.
   ~AsyncVideoWriter();

@@ -20,7 +20,8 @@ class RecordingWriter {
   // (EXR sources) are encoded with `response` first.
   RecordingWriter(std::filesystem::path dir, bool images, double fps, CameraResponse response);
 
-  // Appends a frame (renumbered from 0). Throws InputError when the video cannot be written.
+  // Appends a frame (renumbered from 0). Throws as VideoEncoder does when the video cannot be
+  // written (InputError for the path, SystemError for a full disk or a missing encoder).
   void Write(const Frame& frame);
   // Closes the video and writes frames.csv. Returns the number of frames.
   int Finish();

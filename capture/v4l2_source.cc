@@ -159,7 +159,7 @@ class V4l2Source final : public FrameSource {
       // Streaming starts with the first frame asked for, not at open: the bake between the two
       // would leave the buffers holding frames from before it and the sequence numbers a gap.
       v4l2_buf_type type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
-      if (Ioctl(fd_, VIDIOC_STREAMON, &type) < 0) ThrowInputError("{}: cannot start streaming", device_);
+      if (Ioctl(fd_, VIDIOC_STREAMON, &type) < 0) ThrowSystemError("{}: cannot start streaming ({})", device_, std::strerror(errno));
       streaming_ = true;
     }
     pollfd p{fd_, POLLIN, 0};
@@ -228,8 +228,15 @@ class V4l2Source final : public FrameSource {
   void Open() {
     fd_ = ::open(device_.c_str(), O_RDWR | O_NONBLOCK);
     if (fd_ < 0) {
-      ThrowInputError("{}: cannot open ({}){}", device_, std::strerror(errno),
-                      errno == ENOENT ? "; is the camera plugged in?" : "");
+      // No such device is the name the user gave; a device there that will not open (busy, not
+      // permitted, failing) is the machine's.
+      const int error = errno;
+      if (error == ENOENT || error == ENOTDIR || error == ENXIO || error == ENODEV) {
+        ThrowInputError("{}: cannot open ({}){}", device_, std::strerror(error),
+                        error == ENOENT ? "; is the camera plugged in?" : "");
+      }
+      ThrowSystemError("{}: cannot open ({}){}", device_, std::strerror(error),
+                       error == EBUSY ? "; another program is using it" : error == EACCES ? "; is this user in the video group?" : "");
     }
     try {
       Configure();
@@ -253,7 +260,7 @@ class V4l2Source final : public FrameSource {
     fmt.fmt.pix.height = static_cast<uint32_t>(chosen->height);
     fmt.fmt.pix.pixelformat = chosen->fourcc;
     fmt.fmt.pix.field = V4L2_FIELD_NONE;
-    if (Ioctl(fd_, VIDIOC_S_FMT, &fmt) < 0) ThrowInputError("{}: cannot set {} {}x{}", device_, FourccName(chosen->fourcc), chosen->width, chosen->height);
+    if (Ioctl(fd_, VIDIOC_S_FMT, &fmt) < 0) ThrowSystemError("{}: cannot set {} {}x{} ({})", device_, FourccName(chosen->fourcc), chosen->width, chosen->height, std::strerror(errno));
     format_ = {fmt.fmt.pix.pixelformat, static_cast<int>(fmt.fmt.pix.width), static_cast<int>(fmt.fmt.pix.height), chosen->fps};
     v4l2_streamparm parm{};
     parm.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
@@ -335,17 +342,17 @@ class V4l2Source final : public FrameSource {
     request.count = static_cast<uint32_t>(options_.buffers);
     request.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
     request.memory = V4L2_MEMORY_MMAP;
-    if (Ioctl(fd_, VIDIOC_REQBUFS, &request) < 0 || request.count < 2) ThrowInputError("{}: cannot get mmap buffers", device_);
+    if (Ioctl(fd_, VIDIOC_REQBUFS, &request) < 0 || request.count < 2) ThrowSystemError("{}: cannot get mmap buffers ({})", device_, std::strerror(errno));
     for (uint32_t i = 0; i < request.count; ++i) {
       v4l2_buffer buffer{};
       buffer.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
       buffer.memory = V4L2_MEMORY_MMAP;
       buffer.index = i;
-      if (Ioctl(fd_, VIDIOC_QUERYBUF, &buffer) < 0) ThrowInputError("{}: cannot query buffer {}", device_, i);
+      if (Ioctl(fd_, VIDIOC_QUERYBUF, &buffer) < 0) ThrowSystemError("{}: cannot query buffer {} ({})", device_, i, std::strerror(errno));
       void* data = ::mmap(nullptr, buffer.length, PROT_READ | PROT_WRITE, MAP_SHARED, fd_, buffer.m.offset);
-      if (data == MAP_FAILED) ThrowInputError("{}: cannot map buffer {}", device_, i);
+      if (data == MAP_FAILED) ThrowSystemError("{}: cannot map buffer {} ({})", device_, i, std::strerror(errno));
       mapped_.emplace_back(data, buffer.length);
-      if (Ioctl(fd_, VIDIOC_QBUF, &buffer) < 0) ThrowInputError("{}: cannot queue buffer {}", device_, i);
+      if (Ioctl(fd_, VIDIOC_QBUF, &buffer) < 0) ThrowSystemError("{}: cannot queue buffer {} ({})", device_, i, std::strerror(errno));
     }
     streaming_ = false;  // STREAMON with the first Next()
     last_sequence_ = -1;

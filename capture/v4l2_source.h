@@ -79,7 +79,8 @@ struct V4l2Options {
 };
 
 // Opens `device` and configures it; streaming starts with the first Next(). Throws InputError "<device>: ..." when it does not exist,
-// is not a V4L2 capture device, or offers neither MJPEG nor YUYV.
+// is not a V4L2 capture device, or offers neither MJPEG nor YUYV; SystemError when a device that is
+// there fails (busy, not permitted, an ioctl or mmap refused).
 std::unique_ptr<FrameSource> OpenV4l2Source(const std::string& device, const V4l2Options& options);
 
 }  // namespace daylit::capture

@@ -10,6 +10,7 @@ extern "C" {
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include <opencv2/imgproc.hpp>
 
@@ -17,6 +18,16 @@ extern "C" {
 #include "capture/video_decoder.h"
 
 namespace daylit::capture {
+namespace {
+
+// libav's words for an error code.
+std::string AvError(int error) {
+  char text[AV_ERROR_MAX_STRING_SIZE] = {};
+  av_strerror(error, text, sizeof(text));
+  return text;
+}
+
+}  // namespace
 
 struct VideoEncoder::State {
   std::filesystem::path path;
@@ -43,7 +54,9 @@ struct VideoEncoder::State {
     while (avcodec_receive_packet(codec, packet) == 0) {
       av_packet_rescale_ts(packet, codec->time_base, stream->time_base);
       packet->stream_index = stream->index;
-      if (av_interleaved_write_frame(format, packet) < 0) ThrowInputError("{}: cannot write video data", path.string());
+      if (const int error = av_interleaved_write_frame(format, packet); error < 0) {
+        ThrowSystemError("{}: cannot write video data: {}", path.string(), AvError(error));
+      }
     }
   }
 };
@@ -58,7 +71,7 @@ VideoEncoder::VideoEncoder(const std::filesystem::path& path, int width, int hei
     ThrowInputError("{}: no video container for this file name (use .mp4 or .mkv)", path.string());
   }
   const AVCodec* encoder = avcodec_find_encoder_by_name("libx264");
-  if (encoder == nullptr) ThrowInputError("{}: this FFmpeg has no libx264 encoder", path.string());
+  if (encoder == nullptr) ThrowSystemError("{}: this FFmpeg has no libx264 encoder (Debian's libavcodec has it: scripts/setup.sh)", path.string());
   s.stream = avformat_new_stream(s.format, nullptr);
   s.codec = avcodec_alloc_context3(encoder);
   const AVRational rate = av_d2q(options.fps, 100000);
@@ -74,17 +87,23 @@ VideoEncoder::VideoEncoder(const std::filesystem::path& path, int width, int hei
   if (s.format->oformat->flags & AVFMT_GLOBALHEADER) s.codec->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
   av_opt_set(s.codec->priv_data, "preset", options.preset, 0);
   av_opt_set_int(s.codec->priv_data, "crf", options.crf, 0);
-  if (avcodec_open2(s.codec, encoder, nullptr) < 0) ThrowInputError("{}: cannot open the H.264 encoder", path.string());
+  if (const int error = avcodec_open2(s.codec, encoder, nullptr); error < 0) {
+    ThrowSystemError("{}: cannot open the H.264 encoder: {}", path.string(), AvError(error));
+  }
   avcodec_parameters_from_context(s.stream->codecpar, s.codec);
   s.stream->time_base = s.codec->time_base;
   s.stream->avg_frame_rate = rate;
   s.stream->r_frame_rate = rate;
-  if (avio_open(&s.format->pb, path.c_str(), AVIO_FLAG_WRITE) < 0) ThrowInputError("{}: cannot open for writing", path.string());
-  if (avformat_write_header(s.format, nullptr) < 0) ThrowInputError("{}: cannot write the video header", path.string());
+  if (const int error = avio_open(&s.format->pb, path.c_str(), AVIO_FLAG_WRITE); error < 0) {
+    ThrowInputError("{}: cannot open for writing: {}", path.string(), AvError(error));
+  }
+  if (const int error = avformat_write_header(s.format, nullptr); error < 0) {
+    ThrowSystemError("{}: cannot write the video header: {}", path.string(), AvError(error));
+  }
   s.frame = av_frame_alloc();
   s.frame->format = AV_PIX_FMT_YUV420P;
   s.frame->width = width, s.frame->height = height;
-  if (av_frame_get_buffer(s.frame, 0) < 0) ThrowInputError("{}: out of memory for a frame", path.string());
+  if (av_frame_get_buffer(s.frame, 0) < 0) ThrowSystemError("{}: out of memory for a frame", path.string());
   s.packet = av_packet_alloc();
 }
 
@@ -111,7 +130,9 @@ void VideoEncoder::Write(const cv::Mat& frame) {
   RgbToYuv420(rgb, s.frame->data[0], s.frame->linesize[0], s.frame->data[1], s.frame->linesize[1], s.frame->data[2],
               s.frame->linesize[2]);
   s.frame->pts = s.next_pts++;
-  if (avcodec_send_frame(s.codec, s.frame) < 0) ThrowInputError("{}: the encoder refused a frame", s.path.string());
+  if (const int error = avcodec_send_frame(s.codec, s.frame); error < 0) {
+    ThrowSystemError("{}: the encoder refused a frame: {}", s.path.string(), AvError(error));
+  }
   s.Drain();
 }
 
@@ -121,8 +142,13 @@ void VideoEncoder::Finish() {
   s.finished = true;
   avcodec_send_frame(s.codec, nullptr);
   s.Drain();
-  if (av_write_trailer(s.format) < 0) ThrowInputError("{}: cannot finish the video", s.path.string());
-  avio_closep(&s.format->pb);
+  if (const int error = av_write_trailer(s.format); error < 0) {
+    ThrowSystemError("{}: cannot finish the video: {}", s.path.string(), AvError(error));
+  }
+  // The last buffered bytes go out on close: a full disk shows here.
+  if (const int error = avio_closep(&s.format->pb); error < 0) {
+    ThrowSystemError("{}: cannot finish the video: {}", s.path.string(), AvError(error));
+  }
 }
 
 void RgbToYuv420(const cv::Mat& rgb, uint8_t* y, int y_stride, uint8_t* u, int u_stride, uint8_t* v, int v_stride) {

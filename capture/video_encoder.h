@@ -24,7 +24,8 @@ struct VideoEncoderOptions {
 class VideoEncoder {
  public:
   // Opens `path` (.mp4 or .mkv) for width × height frames (even sizes). Throws InputError naming
-  // the file when it cannot.
+  // the file when the path or sizes are wrong, SystemError when the machine lacks or fails at it
+  // (no libx264, no memory; a write that fails, as on a full disk, here or in Write and Finish).
   VideoEncoder(const std::filesystem::path& path, int width, int height, const VideoEncoderOptions& options = {});
   ~VideoEncoder();  // finishes the file if Finish() was not called
   VideoEncoder(const VideoEncoder&) = delete;

@@ -2,8 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <filesystem>
 #include <random>
+#include <string>
+
+#include <sys/resource.h>
 
 #include <opencv2/imgproc.hpp>
 
@@ -79,6 +83,47 @@ TEST(VideoEncoderTest, BadSizesAndPathsAreErrorsNamingTheFile) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("/no/such/folder/out.mp4: cannot open for writing"), std::string::npos) << e.what();
   }
+}
+
+// A full disk is the machine's failure (SystemError, exit 1), not the input's: the file's size
+// limited to 16 KiB for this process (its signal ignored, so writes fail with EFBIG as on a full
+// disk), lossless frames of noise, tens of KiB each.
+TEST(VideoEncoderTest, AFullDiskIsTheMachinesFailureNotTheInputs) {
+  const fs::path dir = fs::path(DAYLIT_BINARY_DIR) / "video_encoder_test";
+  fs::create_directories(dir);
+  const fs::path file = dir / "full.mp4";
+  struct LimitedFileSize {
+    rlimit before{};
+    void (*handler)(int) = SIG_DFL;
+    LimitedFileSize() {
+      getrlimit(RLIMIT_FSIZE, &before);
+      handler = std::signal(SIGXFSZ, SIG_IGN);
+      rlimit limited = before;
+      limited.rlim_cur = 16 * 1024;
+      setrlimit(RLIMIT_FSIZE, &limited);
+    }
+    ~LimitedFileSize() {
+      setrlimit(RLIMIT_FSIZE, &before);
+      std::signal(SIGXFSZ, handler);
+    }
+  };
+  std::string message;
+  {
+    const LimitedFileSize limit;
+    try {
+      VideoEncoder encoder(file, 160, 120, VideoEncoderOptions{10.0, 0, "veryfast"});
+      for (int i = 0; i < 20; ++i) encoder.Write(TestFrame(160, 120, i, 0.3f));
+      encoder.Finish();
+      ADD_FAILURE() << "no error";
+    } catch (const SystemError& e) {
+      message = e.what();
+    } catch (const InputError& e) {
+      ADD_FAILURE() << "an input error: " << e.what();
+    }
+  }
+  EXPECT_NE(message.find(file.string() + ": cannot"), std::string::npos) << message;
+  EXPECT_NE(message.find("too large"), std::string::npos) << message;  // EFBIG's words, from libav
+  fs::remove(file);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <new>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -108,9 +109,14 @@ int main(int argc, char** argv) {
   } catch (const daylit::InvariantError& e) {
     daylit::Log().critical("internal error (a bug in daylit, not your input): {}", e.what());
     return daylit::kInternalErrorExitCode;
-  } catch (const std::exception& e) {
-    daylit::Log().critical("internal error: {}", e.what());
+  } catch (const std::bad_alloc&) {
+    // What the machine lacks, not the input and not daylit.
+    daylit::Log().error("out of memory: this machine has too little for this run");
     return 1;
+  } catch (const std::exception& e) {
+    // Anything else no part of daylit said is the input's or the machine's: a bug.
+    daylit::Log().critical("internal error (a bug in daylit, not your input): {}", e.what());
+    return daylit::kInternalErrorExitCode;
   }
   return 0;
 }
