@@ -102,6 +102,11 @@ std::filesystem::path BurstsCsvPath(const std::filesystem::path& csv) {
   return csv.parent_path() / (csv.stem().string() + "_bursts.csv");
 }
 
+std::filesystem::path ReportPathBeside(const std::filesystem::path& csv) {
+  if (csv.filename() == "estimates.csv") return csv.parent_path() / "report.txt";
+  return csv.parent_path() / (csv.stem().string() + "_report.txt");
+}
+
 std::vector<Burst> SplitBursts(const std::vector<estimation::FrameEstimate>& frames, double gap_s) {
   std::vector<Burst> bursts;
   for (size_t i = 0; i < frames.size(); ++i) {

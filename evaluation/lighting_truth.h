@@ -91,6 +91,10 @@ std::string BurstsCsv(const std::vector<BurstLighting>& bursts);
 // Where the bursts' table goes beside the estimates' CSV `csv`: bursts.csv beside estimates.csv,
 // else <stem>_bursts.csv.
 std::filesystem::path BurstsCsvPath(const std::filesystem::path& csv);
+// Where `daylit estimate` writes its report beside the estimates' CSV `csv` (evaluation/run_report.h:
+// the text it prints, the version and how the run was started): report.txt beside estimates.csv,
+// else <csv stem>_report.txt.
+std::filesystem::path ReportPathBeside(const std::filesystem::path& csv);
 
 // Estimate vs truth over time, per channel: a PNG with a sun panel and a sky panel.
 void PlotEstimates(const std::vector<estimation::FrameEstimate>& frames, const TruthComparison* truth,

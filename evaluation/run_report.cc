@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "base/atomic_file.h"
+#include "base/invocation.h"
 #include "base/version.h"
 
 namespace daylit::evaluation {
@@ -18,8 +19,26 @@ void RunReport::Say(const std::string& line) {
   text_ += '\n';
 }
 
+namespace {
+
+// How the run was started (base/invocation.h), for report.txt's head and figures.json's run/ keys.
+std::string RunHead() {
+  const Invocation& run = CurrentInvocation();
+  if (run.argv.empty()) return "";
+  return fmt::format("run: {}\nin: {}\nstarted: {}\n", run.CommandLine(), run.cwd, run.started_utc);
+}
+
+}  // namespace
+
 std::string RunReport::FiguresJson() const {
   nlohmann::json json = nlohmann::json::object();
+  json["run/daylit"] = kVersion;
+  if (const Invocation& run = CurrentInvocation(); !run.argv.empty()) {
+    json["run/command"] = run.CommandLine();
+    json["run/argv"] = run.argv;
+    json["run/cwd"] = run.cwd;
+    json["run/started_utc"] = run.started_utc;
+  }
   for (const auto& [key, value] : figures_) {
     if (const double* number = std::get_if<double>(&value); number != nullptr && std::floor(*number) == *number &&
                                                              std::abs(*number) < 1e15) {
@@ -32,7 +51,7 @@ std::string RunReport::FiguresJson() const {
 }
 
 void RunReport::Write(const std::filesystem::path& file) const {
-  WriteFileAtomically(file, fmt::format("daylit {}\n{}", kVersion, text_));
+  WriteFileAtomically(file, fmt::format("daylit {}\n{}{}", kVersion, RunHead(), text_));
 }
 
 void RunReport::WriteFigures(const std::filesystem::path& file) const { WriteFileAtomically(file, FiguresJson()); }

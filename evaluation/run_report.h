@@ -21,9 +21,13 @@ class RunReport {
   void Figure(const std::string& key, const std::string& value) { figures_[key] = value; }
 
   const std::string& text() const { return text_; }
-  // The figures as one JSON object, keys sorted.
+  // The figures as one JSON object, keys sorted, with how the run was started: run/daylit (the
+  // version), and where main() recorded it (base/invocation.h) run/command (one line a shell
+  // reads back), run/argv, run/cwd, run/started_utc.
   std::string FiguresJson() const;
-  // The text with the build's version (base/version.h) on its first line.
+  // The text with the build's version (base/version.h) on its first line, then the command line,
+  // the folder it ran in and when it started (`run:`, `in:`, `started:`), where main() recorded them:
+  // enough to repeat the run from its output folder.
   void Write(const std::filesystem::path& file) const;
   void WriteFigures(const std::filesystem::path& file) const;
 

@@ -250,6 +250,10 @@ TEST(CliTest, EstimateWritesTheStableCsv) {
   EXPECT_NE(run.out.find("burst 0: E_sun not observed in 1 of 1 frames: the sun below the horizon"), std::string::npos)
       << run.out;
   EXPECT_EQ(ReadCsvFile(rec.dir / "est_bursts.csv").rows.size(), 1u);  // the per-burst table, no truth
+  // The report beside it: what was printed, after the version and how the run was started.
+  const std::string report = ReadTextFile(rec.dir / "est_report.txt");
+  EXPECT_NE(report.find("\nrun: " + figures_json.at("run/command").get<std::string>() + "\n"), std::string::npos) << report;
+  EXPECT_NE(report.find("burst 0: E_sun not observed in 1 of 1 frames"), std::string::npos) << report;
   const CsvTable table = ReadCsvFile(out);
   EXPECT_EQ(table.header, (std::vector<std::string>{"frame", "time_utc", "sun_elevation_deg", "sun_azimuth_deg", "sun_r",
                                                      "sun_g", "sun_b", "sky_r", "sky_g", "sky_b", "confidence", "samples",
@@ -607,6 +611,16 @@ TEST(CliTest, ReplayWritesTheAugmentedVideoAndItsReport) {
   EXPECT_GT(figures.at("fps").get<double>(), 0.0);
   EXPECT_LT(figures.at("composite/objects/worst").get<double>(), 0.10);
   EXPECT_NE(figures.at("gl_renderer").get<std::string>(), "");
+  // How the run was started, saved beside its results (issue 39): the command line as typed, the
+  // folder it ran in, the version.
+  const std::string command = figures.at("run/command").get<std::string>();
+  EXPECT_NE(command.find(" replay " + kRecording + " --frames 60 --cache "), std::string::npos) << command;
+  EXPECT_EQ(figures.at("run/argv").size(), 9u);
+  EXPECT_EQ(figures.at("run/cwd").get<std::string>(), fs::current_path().string());
+  EXPECT_NE(figures.at("run/daylit").get<std::string>(), "");
+  const std::string report = ReadTextFile(dir / "report.txt");
+  EXPECT_NE(report.find("\nrun: " + command + "\nin: " + fs::current_path().string() + "\nstarted: "), std::string::npos)
+      << report;
   EXPECT_EQ(ReadCsvFile(dir / "estimates.csv").rows.size(), 60u);
   // Frames 40 and 50 against the truth: the issue's bar is 10% on the objects and their shadows.
   const CsvTable fidelity = ReadCsvFile(dir / "fidelity.csv");

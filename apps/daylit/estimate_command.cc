@@ -42,13 +42,15 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
     ThrowInputError("--figures: {} must end in .json", o.figures);
   }
   const std::string plot = o.plot.empty() ? std::filesystem::path(o.out).replace_extension(".png").string() : o.plot;
+  const std::filesystem::path report_file = evaluation::ReportPathBeside(o.out);
   RefuseSharedOutputs({{"--out", o.out}, {"--plot (or the --out's .png)", plot},
-                       {"the bursts' table", evaluation::BurstsCsvPath(o.out)}, {"--figures", o.figures}});
+                       {"the bursts' table", evaluation::BurstsCsvPath(o.out)}, {"the report", report_file},
+                       {"--figures", o.figures}});
   RequireWritable("--out", o.out), RequireWritable("--plot", plot), RequireWritable("--figures", o.figures);
   const scene::Scene scene = scene::LoadScene(o.recording);
   std::vector<std::pair<std::string, std::filesystem::path>> outputs = {
       {"--out", o.out}, {"--plot (or the --out's .png)", plot}, {"the bursts' table", evaluation::BurstsCsvPath(o.out)},
-      {"--figures", o.figures}, {"--residuals", o.residuals}};
+      {"the report", report_file}, {"--figures", o.figures}, {"--residuals", o.residuals}};
   if (!o.residuals.empty()) {
     for (const char* name : {"residuals.csv", "residuals.png", "worst_frame_residuals.png", "split_check.csv", "split_check.png"}) {
       outputs.emplace_back(fmt::format("--residuals' {}", name), std::filesystem::path(o.residuals) / name);
@@ -89,14 +91,15 @@ void RunEstimateCommand(const EstimateCommandOptions& o) {
   if (residuals) residuals->Finish(o.residuals, &report);
   if (split) split->Finish(o.residuals, &report);
   if (shadows) CheckShadowsAndSay(scene, baked, caster, shadows->Finish(), &report);
+  report.Write(report_file);
   if (!o.figures.empty()) report.WriteFigures(o.figures);
   // Frames whose sun moved are timed as sun moves: a one-frame run has no per-frame figure.
   const std::string per_frame = std::isfinite(run.median_estimate_ms) ? fmt::format("{:.2f} ms", run.median_estimate_ms)
                                                                       : std::string("not timed (every frame moved the sun)");
   Log().info("{} frames in {:.2f} s ({:.0f} fps end to end); estimation after decoding {} per frame (median), "
-             "plus {} sun moves taking {:.0f} ms in all; wrote {} and {}",
+             "plus {} sun moves taking {:.0f} ms in all; wrote {}, {} and {}",
              n, run.seconds, static_cast<double>(n) / std::max(run.seconds, 1e-9), per_frame,
-             run.sun_moves_ms.size(), moves_ms, o.out, plot);
+             run.sun_moves_ms.size(), moves_ms, o.out, plot, report_file.string());
   if (run.undecodable > 0) Log().warn("{} frames could not be decoded", run.undecodable);
 }
 

@@ -14,6 +14,7 @@
 #include "capture/video_decoder.h"
 #include "base/check.h"
 #include "base/error.h"
+#include "base/invocation.h"
 #include "base/log.h"
 #include "base/version.h"
 #include "scene/scene.h"
@@ -43,6 +44,7 @@ void RefuseNonFiniteNumbers(CLI::App* app) {
 int main(int argc, char** argv) {
   // libav's and OpenCV's own lines would come before daylit's one-line messages: libav's go to
   // daylit's logger (debug), OpenCV's are silenced (daylit says what failed itself).
+  daylit::RecordInvocation(argc, argv);  // saved beside a run's results (report.txt, figures.json)
   daylit::capture::RouteLibavLogging();
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   CLI::App app{"daylit: estimate sun and sky light from a camera and light virtual objects with it"};
