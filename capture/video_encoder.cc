@@ -66,6 +66,7 @@ VideoEncoder::VideoEncoder(const std::filesystem::path& path, int width, int hei
   RouteLibavLogging();
   State& s = *state_;
   s.path = path;
+  if (const std::string why = options.Check(); !why.empty()) ThrowInputError("{}: {}", path.string(), why);
   if (width % 2 != 0 || height % 2 != 0) ThrowInputError("{}: {}x{}: H.264 4:2:0 needs even sizes", path.string(), width, height);
   if (avformat_alloc_output_context2(&s.format, nullptr, nullptr, path.c_str()) < 0 || s.format == nullptr) {
     ThrowInputError("{}: no video container for this file name (use .mp4 or .mkv)", path.string());

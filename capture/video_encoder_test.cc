@@ -77,6 +77,16 @@ TEST(VideoEncoderTest, LosslessH264ReadsBackExactlyWithFrameNumbers) {
 
 TEST(VideoEncoderTest, BadSizesAndPathsAreErrorsNamingTheFile) {
   EXPECT_THROW(VideoEncoder("/tmp/odd.mp4", 161, 120), InputError);
+  // Its options are checked before anything is opened: a frame rate no video has.
+  const fs::path fast = fs::path(DAYLIT_BINARY_DIR) / "video_encoder_test" / "fast.mp4";
+  fs::create_directories(fast.parent_path());
+  try {
+    VideoEncoder(fast, 160, 120, VideoEncoderOptions{5000.0});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(fast.string() + ": fps: 5000"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(fast));
   try {
     VideoEncoder("/no/such/folder/out.mp4", 160, 120);
     ADD_FAILURE() << "no error";

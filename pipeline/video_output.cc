@@ -26,6 +26,10 @@ VideoOutput::VideoOutput(const fs::path& out, const scene::Scene& scene) : out_(
     std::error_code ec;
     fs::remove(partial_, ec);
     ThrowInputError("--out: cannot write {} ({})", out.string(), e.what());
+  } catch (...) {  // the machine's (no libx264, a full disk): nothing half-written left either
+    std::error_code ec;
+    fs::remove(partial_, ec);
+    throw;
   }
 }
 

@@ -51,6 +51,10 @@ void RefuseInputsAsOutputs(const scene::Scene& scene,
 // not wasted on an output that cannot be written. Empty paths are skipped.
 void RequireWritable(const std::string& option, const std::filesystem::path& path);
 
+// An options struct's Check() before any work: its first problem, if any, as an input error
+// "<what>: <problem>" (the problem names the field).
+void RequireValid(const std::string& what, const std::string& problem);
+
 // --lighting volume|lights:N, for the commands that render the objects (render::ParseLighting).
 void AddLightingOption(CLI::App* cmd, std::string* lighting);
 

@@ -76,6 +76,10 @@ void RefuseInputsAsOutputs(const scene::Scene& scene,
   }
 }
 
+void RequireValid(const std::string& what, const std::string& problem) {
+  if (!problem.empty()) ThrowInputError("{}: {}", what, problem);
+}
+
 void RequireWritable(const std::string& option, const std::filesystem::path& path) {
   namespace fs = std::filesystem;
   if (path.empty()) return;

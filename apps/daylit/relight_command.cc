@@ -207,6 +207,7 @@ void RelightVideo(const RelightOptions& o, const scene::Scene& scene, const bake
   options.stop = interrupt.flag();
   if (range.last_position) options.max_frames = static_cast<int>(*range.last_position) + 1;
   options.first_output_frame = range.first;
+  RequireValid("options", options.Check());
   pipeline::LightingPipeline lighting(scene, baked, caster, options);
   lighting.SetStage(stage);
   lighting.SetVideo(&video->writer());
@@ -258,6 +259,7 @@ void RunRelight(const RelightOptions& o) {
   pipeline::RelightStageOptions options;
   options.relight.sky = o.sky == "follow" ? relight::SkyPixels::kFollow : relight::SkyPixels::kKeep;
   options.gpu = o.gpu;
+  RequireValid("relight options", options.Check());
   std::unique_ptr<render::FrameRenderer> renderer;
   if (o.objects) renderer = std::make_unique<render::FrameRenderer>(scene, baked, caster);
   pipeline::RelightStage stage(scene, baked, caster, target, options, renderer.get());

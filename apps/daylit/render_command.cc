@@ -51,6 +51,7 @@ void RunRender(const RenderOptions& o) {
   const size_t position = scene::FramePosition(scene, o.frame, "--frame");
   render::FrameRendererOptions options;
   options.lights = render::ParseLighting(o.lighting, "--lighting");
+  RequireValid("render options", options.Check());
   std::string why;
   const auto gl = render::HeadlessGlContext::Create(&why);
   if (gl == nullptr) ThrowSystemError("OpenGL: {}", why);

@@ -152,6 +152,7 @@ scene::Scene CalibrateOnTheCamera(const scene::Scene& scene, const bake::SceneBa
   options.max_frames = std::max(1, static_cast<int>(std::lround(seconds * scene.frames.fps)));
   options.progress_label = "calibrate";
   options.stop = stop;
+  RequireValid("--calibrate", options.Check());
   pipeline::LightingPipeline lighting(scene, baked, caster, options);
   calibrate::ObserveOptions observe;
   observe.max_burst_s = kCalibrationStretchS;
@@ -268,6 +269,7 @@ void RunReplay(const ReplayOptions& o) {
   if (!o.serve.empty()) server.emplace(serve::ParseHostPort(o.serve, "--serve"), SceneJson(scene));
   render::FrameRendererOptions render_options;
   render_options.lights = render::ParseLighting(o.lighting, "--lighting");
+  RequireValid("render options", render_options.Check());
   render::TimeSlider slider(scene.location.longitude_deg);
   if (!o.relight_at.empty()) slider.SetUtcMinutes(render::ParseUtcTimeOfDay(o.relight_at, "--relight-at"));
   // Everything that can fail without the bake fails before it: the frames, GL, the output.
@@ -303,6 +305,7 @@ void RunReplay(const ReplayOptions& o) {
   options.max_frames = o.frames;
   options.progress_label = "replay";
   options.stop = interrupt.flag();
+  RequireValid("options", options.Check());
   pipeline::LightingPipeline lighting(scene, baked, caster, options);
   lighting.SetStage(&composite);
   lighting.AddSink(&fidelity);
