@@ -125,7 +125,7 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
     r.burst = b;
     r.first_frame = frames[b.begin].frame, r.last_frame = frames[b.end - 1].frame;
     r.sun_elevation_deg = frames[b.begin].sun_elevation_deg;
-    std::array<std::vector<double>, 3> sun, sky, sun_error, sky_error, sun_half, sky_half, sun_bound;
+    std::array<std::vector<double>, 3> sun, sky, sun_error, sky_error, sun_half, sky_half, sun_bound, sun_share;
     std::vector<double> confidence, sunlit, shadowed;
     r.min_confidence = 1.0;
     for (size_t i = b.begin; i < b.end; ++i) {
@@ -148,6 +148,8 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
         const int c = static_cast<int>(k);
         if (t.sun_rgb[c] > 0) sun_error[k].push_back(std::abs(f.light.sun_rgb[c] / t.sun_rgb[c] - 1.0));
         if (t.sky_rgb[c] > 0) sky_error[k].push_back(std::abs(f.light.sky_rgb[c] / t.sky_rgb[c] - 1.0));
+        const double horizontal = std::max(0.0, t.sun_rgb[c] * std::sin(glm::radians(f.sun_elevation_deg)));
+        if (horizontal + t.sky_rgb[c] > 0.0) sun_share[k].push_back(horizontal / (horizontal + t.sky_rgb[c]));
       }
     }
     r.confidence = Median(confidence);
@@ -159,6 +161,7 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
       if (!sun_half[k].empty()) r.sun_half_width[c] = Median(sun_half[k]), r.sky_half_width[c] = Median(sky_half[k]);
       if (!sun_bound[k].empty() && 2 * sun_bound[k].size() >= sun_half[k].size()) r.sun_bound[c] = Median(sun_bound[k]);
       if (r.has_truth) r.sun_error[c] = Median(sun_error[k]), r.sky_error[c] = Median(sky_error[k]);
+      if (!sun_share[k].empty()) r.true_sun_share[c] = Median(sun_share[k]);
     }
     if (r.has_truth) {
       r.interval_covers = true;
@@ -179,7 +182,9 @@ std::string BurstsCsv(const std::vector<BurstLighting>& bursts) {
                     "min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,frames_without_shadowed,";
   csv += estimation::IntervalCsvHeader();
   csv += ",frames_sun_not_observed";
-  csv += truth ? ",sun_error_r,sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b,interval_covers\n" : "\n";
+  csv += truth ? ",sun_error_r,sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b,interval_covers,"
+                 "true_sun_share_r,true_sun_share_g,true_sun_share_b\n"
+               : "\n";
   for (const BurstLighting& b : bursts) {
     csv += fmt::format("{},{},{},{},{:.3f},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.4f},{:.4f}", b.burst.index,
                        b.first_frame, b.last_frame, b.burst.end - b.burst.begin, b.sun_elevation_deg, b.sun.x, b.sun.y,
@@ -191,8 +196,9 @@ std::string BurstsCsv(const std::vector<BurstLighting>& bursts) {
     csv += estimation::IntervalCsvFields(estimation::BoundsOf({b.sun, b.sky}, interval));
     csv += fmt::format(",{}", b.frames_sun_not_observed);
     if (truth) {
-      csv += fmt::format(",{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{}", b.sun_error.x, b.sun_error.y, b.sun_error.z,
-                         b.sky_error.x, b.sky_error.y, b.sky_error.z, b.interval_covers ? 1 : 0);
+      csv += fmt::format(",{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{},{:.4f},{:.4f},{:.4f}", b.sun_error.x, b.sun_error.y,
+                         b.sun_error.z, b.sky_error.x, b.sky_error.y, b.sky_error.z, b.interval_covers ? 1 : 0,
+                         b.true_sun_share.x, b.true_sun_share.y, b.true_sun_share.z);
     }
     csv += "\n";
   }
@@ -269,6 +275,7 @@ void ReportBursts(const std::vector<BurstLighting>& bursts, const std::filesyste
     for (int c = 0; truth && c < 3; ++c) {
       report->Figure(key + "sun_error/" + std::string(1, "rgb"[c]), b.sun_error[c]);
       report->Figure(key + "sky_error/" + std::string(1, "rgb"[c]), b.sky_error[c]);
+      report->Figure(key + "true_sun_share/" + std::string(1, "rgb"[c]), b.true_sun_share[c]);
     }
   }
   // The 90% intervals, from the frames alone (estimation/light_interval.h), and with truth whether
@@ -306,6 +313,18 @@ void ReportBursts(const std::vector<BurstLighting>& bursts, const std::filesyste
   }
   for (const BurstLighting& b : bursts) {
     const int frames = static_cast<int>(b.burst.end - b.burst.begin);
+    if (truth && (b.WeakSun(0) || b.WeakSun(1) || b.WeakSun(2))) {
+      std::string channels;
+      bool held = true;
+      for (int c = 0; c < 3; ++c) {
+        if (!b.WeakSun(c)) continue;
+        channels += fmt::format("{}{} {:.1f}%", channels.empty() ? "" : ", ", "RGB"[c], 100 * b.true_sun_share[c]);
+        held = held && b.SunHeldByInterval(c);
+      }
+      report->Say(fmt::format("  burst {}: the true sun is under {:g}% of the horizontal light ({}): a relative error of "
+                              "E_sun means little there, and its bar is the interval, which {} it",
+                              b.burst.index, 100 * kWeakSunShare, channels, held ? "holds" : "MISSES"));
+    }
     if (b.frames_without_sunlit > 0) {
       report->Say(fmt::format("  burst {}: no sunlit sample in {} of {} frames while the sun was up: E_sun is not observed "
                               "there (fit confidence 0): the estimate holds the last fit that saw the sun, or the burst's "

@@ -23,6 +23,9 @@ struct ConfidenceRanking {
   double bad_below_90_percent_of_good = NAN;
 };
 constexpr double kBadFrameError = 0.10, kGoodFrameError = 0.05;
+// The true sun's share of the horizontal light below which E_sun's bar is its interval, not its
+// relative error (issue 51's "where the sun is so weak that a relative error means little").
+constexpr double kWeakSunShare = 0.10;
 // `confidence` and `error` aligned; frames with a NaN error are left out.
 ConfidenceRanking RankByConfidence(const std::vector<double>& confidence, const std::vector<double>& error);
 
@@ -80,12 +83,20 @@ struct BurstLighting {
   glm::dvec3 sun_error{NAN}, sky_error{NAN};
   // With truth: each of the six errors within its half-width (E_sun's only where observed).
   bool interval_covers = false;
+  // With truth: the true sun's share of the horizontal light, E_sun·sin(elevation) over that plus
+  // E_sky, per channel, the median over the burst's frames. Under kWeakSunShare a relative error
+  // of E_sun means little (a sun behind cloud, 4% of the light, read as 5% makes a 25% error), and
+  // the bar there is its interval (issue 51): WeakSun(c), and whether the interval holds it.
+  glm::dvec3 true_sun_share{NAN};
+  bool WeakSun(int c) const { return true_sun_share[c] < kWeakSunShare; }
+  bool SunHeldByInterval(int c) const { return sun_error[c] <= sun_half_width[c]; }
 };
 std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEstimate>& frames, const TruthComparison* truth);
 // bursts.csv: burst,first_frame,last_frame,frames,sun_elevation_deg,sun_r,sun_g,sun_b,sky_r,sky_g,
 // sky_b,confidence,min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,
 // frames_without_shadowed,sun_r_lo,sun_r_hi,...,sky_b_lo,sky_b_hi (the 90% interval around the
-// burst's medians),frames_sun_not_observed[,sun_error_r,...,sky_error_b,interval_covers with truth].
+// burst's medians),frames_sun_not_observed[,sun_error_r,...,sky_error_b,interval_covers,
+// true_sun_share_r,true_sun_share_g,true_sun_share_b with truth].
 std::string BurstsCsv(const std::vector<BurstLighting>& bursts);
 
 // Where the bursts' table goes beside the estimates' CSV `csv`: bursts.csv beside estimates.csv,

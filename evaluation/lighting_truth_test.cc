@@ -75,7 +75,7 @@ TEST(LightingTruthTest, EachBurstHasItsOwnMedianErrors) {
             "min_confidence,sunlit_samples,shadowed_samples,frames_without_sunlit,frames_without_shadowed,sun_r_lo,"
             "sun_r_hi,sun_g_lo,sun_g_hi,sun_b_lo,sun_b_hi,sky_r_lo,sky_r_hi,sky_g_lo,sky_g_hi,sky_b_lo,sky_b_hi,"
             "frames_sun_not_observed,sun_error_r,sun_error_g,sun_error_b,sky_error_r,sky_error_g,sky_error_b,"
-            "interval_covers");
+            "interval_covers,true_sun_share_r,true_sun_share_g,true_sun_share_b");
   // The interval: burst 0's errors (20%, 0) lie within ±30% and ±10%, burst 1's E_sky (50%) does not.
   EXPECT_TRUE(bursts[0].interval_covers);
   EXPECT_FALSE(bursts[1].interval_covers);
@@ -84,6 +84,30 @@ TEST(LightingTruthTest, EachBurstHasItsOwnMedianErrors) {
   // Without truth: the estimates only.
   EXPECT_FALSE(CompareBursts(frames, nullptr)[0].has_truth);
   EXPECT_TRUE(std::isnan(CompareBursts(frames, nullptr)[0].sun_error.x));
+}
+
+// Issue 51: where the true sun is under 10% of the horizontal light, E_sun's bar is its interval.
+// The sun at 30° (sin 0.5): E_sun 10 against E_sky 2 is 5 / 7 = 71% of the horizontal light; E_sun
+// 0.3 against 2 is 0.15 / 2.15 = 7.0%, a weak sun, whose estimate of 0.36 (20% off) the interval of
+// ±30% holds.
+TEST(LightingTruthTest, AWeakSunIsJudgedByItsInterval) {
+  std::vector<estimation::FrameEstimate> frames = {Frame(0, 0.0, 10, 2), Frame(1, 0.1, 10, 2), Frame(2, 3600.0, 0.36, 2)};
+  TruthComparison truth;
+  for (estimation::FrameEstimate& f : frames) {
+    f.sun_elevation_deg = 30.0;
+    f.interval.known = f.interval.sun_observed = true;
+    f.interval.sun = glm::dvec3(0.3), f.interval.sky = glm::dvec3(0.1);
+    truth.truth.push_back({glm::dvec3(f.light.sun_rgb.x < 1.0 ? 0.3 : 10.0, 10.0, 10.0), glm::dvec3(2.0)});
+  }
+  const std::vector<BurstLighting> bursts = CompareBursts(frames, &truth);
+  ASSERT_EQ(bursts.size(), 2u);
+  EXPECT_NEAR(bursts[0].true_sun_share.x, 5.0 / 7.0, 1e-9);
+  EXPECT_FALSE(bursts[0].WeakSun(0));
+  EXPECT_NEAR(bursts[1].true_sun_share.x, 0.15 / 2.15, 1e-9);
+  EXPECT_TRUE(bursts[1].WeakSun(0));
+  EXPECT_FALSE(bursts[1].WeakSun(1));  // green's sun is strong there
+  EXPECT_NEAR(bursts[1].sun_error.x, 0.2, 1e-9);
+  EXPECT_TRUE(bursts[1].SunHeldByInterval(0));
 }
 
 // A burst whose sun is not observed in most frames, estimated at 0: its E_sun bound in bursts.csv
