@@ -90,6 +90,20 @@ LightingServer::LightingServer(const ServerOptions& options, std::string scene_j
   s.set_keep_alive_max_count(1000);
   // Every answer, errors and unknown paths included, may be read by a page served from elsewhere.
   s.set_default_headers({{"Access-Control-Allow-Origin", "*"}});
+  // Too many header fields, or too many bytes of them: refused before any route runs.
+  s.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
+    size_t bytes = 0;
+    for (const auto& [name, value] : req.headers) bytes += name.size() + value.size() + 4;  // ": " and CRLF
+    if (req.headers.size() <= options_.max_header_fields && bytes <= options_.max_header_bytes) {
+      return httplib::Server::HandlerResponse::Unhandled;
+    }
+    res.status = 431;
+    res.set_content(nlohmann::json{{"error", fmt::format("{} header fields, {} bytes: at most {} and {}", req.headers.size(),
+                                                         bytes, options_.max_header_fields, options_.max_header_bytes)}}
+                        .dump(),
+                    "application/json");
+    return httplib::Server::HandlerResponse::Handled;
+  });
 
   s.Get("/lighting", [this](const httplib::Request& req, httplib::Response& res) {
     std::shared_ptr<const FrameLighting> latest;

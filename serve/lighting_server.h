@@ -43,6 +43,10 @@ struct ServerOptions {
   int idle_close_s = 10;          // a stream client whose queue stayed full this long is closed
   int max_clients = 32;           // stream and video clients at once; more are answered 503
   int jpeg_quality = 90;
+  // A request with more header fields, or more bytes of them, is answered 431 (cpp-httplib limits
+  // each line to 8 KiB, not their number): a browser sends about 20, 2 KiB.
+  size_t max_header_fields = 100;
+  size_t max_header_bytes = 32 * 1024;
   // The viewer's files: viewer/ (index.html, viewer.js) and node_modules/three (scripts/setup.sh
   // installs it from npm). Without them / says so and the rest is served as ever.
   std::string web_dir = DAYLIT_WEB_DIR;

@@ -250,6 +250,25 @@ TEST(LightingServerTest, AClientThatStallsInItsRequestIsClosedSoon) {
   close(fd);
 }
 
+// A request with thousands of header fields (119 KB were accepted) is refused with 431, its
+// answer readable from any origin; a browser's few are not.
+TEST(LightingServerTest, ARequestWithTooManyHeaderFieldsIsRefused) {
+  LightingServer server({}, "{}");
+  server.Publish(Frame(1));
+  httplib::Client client("127.0.0.1", server.port());
+  httplib::Headers many, few;
+  for (int i = 0; i < 1000; ++i) many.emplace("X-Filler-" + std::to_string(i), "0123456789");
+  for (int i = 0; i < 20; ++i) few.emplace("X-Filler-" + std::to_string(i), "0123456789");
+  const httplib::Result refused = client.Get("/lighting", many);
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 431);
+  EXPECT_EQ(refused->get_header_value("Access-Control-Allow-Origin"), "*");
+  EXPECT_NE(refused->body.find("at most 100"), std::string::npos) << refused->body;
+  const httplib::Result answered = client.Get("/lighting", few);
+  ASSERT_TRUE(answered);
+  EXPECT_EQ(answered->status, 200);
+}
+
 TEST(LightingServerTest, APortTakenIsAnInputErrorNamingItAndWhy) {
   LightingServer first({}, "{}");
   ServerOptions options;
