@@ -53,15 +53,30 @@ struct BurstBar {
   double bar;
 };
 
+// A bundled recording through the pipeline with the default options, against its ground truth
+// (which the caller has checked is there), per frame and per burst.
+struct RunAgainstTruth {
+  pipeline::PipelineRun run;
+  evaluation::TruthComparison truth;
+  std::vector<evaluation::BurstLighting> bursts;
+};
+RunAgainstTruth RunWithTruth(const testing::BundledCourtyard& c) {
+  const scene::RayCaster caster(c.scene.model);
+  pipeline::LightingPipeline lighting(c.scene, c.bake, caster, {});
+  RunAgainstTruth out;
+  out.run = lighting.Run(scene::OpenFrameSource(c.scene));
+  out.truth = evaluation::CompareWithTruth(out.run.frames, *c.scene.groundtruth.lighting);
+  out.bursts = evaluation::CompareBursts(out.run.frames, &out.truth);
+  return out;
+}
+
 // Issues 18 and 37: every burst's median error per channel ≤ 5%, on every recording, and the 90th
 // percentile over frames of the worst channel.
 void ExpectPerBurst(const testing::BundledCourtyard& c, double p90_bar, double auc_bar, const std::vector<BurstBar>& wider = {}) {
-  const scene::RayCaster caster(c.scene.model);
-  pipeline::LightingPipeline lighting(c.scene, c.bake, caster, {});
-  const pipeline::PipelineRun run = lighting.Run(scene::OpenFrameSource(c.scene));
   ASSERT_TRUE(c.scene.groundtruth.lighting.has_value());
-  const evaluation::TruthComparison truth = evaluation::CompareWithTruth(run.frames, *c.scene.groundtruth.lighting);
-  const std::vector<evaluation::BurstLighting> bursts = evaluation::CompareBursts(run.frames, &truth);
+  const RunAgainstTruth measured = RunWithTruth(c);
+  const evaluation::TruthComparison& truth = measured.truth;
+  const std::vector<evaluation::BurstLighting>& bursts = measured.bursts;
   ASSERT_EQ(bursts.size(), c.scene.name == "courtyard-a" ? 6u : 5u);
   for (const evaluation::BurstLighting& b : bursts) {
     double bar = 0.05;
@@ -118,12 +133,8 @@ TEST(EstimateRecordingTest, CourtyardCEveryBurstWithin5Percent) {
 // no wider than half again what it is.
 TEST(EstimateRecordingTest, CourtyardEsIntervalHoldsEveryBurstAndIsTheShadowsWhereTheyTellTheSun) {
   const testing::BundledCourtyard& c = testing::CourtyardE();
-  const scene::RayCaster caster(c.scene.model);
-  pipeline::LightingPipeline lighting(c.scene, c.bake, caster, {});
-  const pipeline::PipelineRun run = lighting.Run(scene::OpenFrameSource(c.scene));
   ASSERT_TRUE(c.scene.groundtruth.lighting.has_value());
-  const evaluation::TruthComparison truth = evaluation::CompareWithTruth(run.frames, *c.scene.groundtruth.lighting);
-  const std::vector<evaluation::BurstLighting> bursts = evaluation::CompareBursts(run.frames, &truth);
+  const std::vector<evaluation::BurstLighting> bursts = RunWithTruth(c).bursts;
   ASSERT_EQ(bursts.size(), 5u);
   std::vector<double> sun_widths, sky_widths;
   for (const evaluation::BurstLighting& b : bursts) {
