@@ -117,7 +117,6 @@ FrameLight FrameEstimator::Estimate(const capture::Frame& frame, const scene::Tr
 FrameLight FrameEstimator::Hold(const capture::Frame& frame, const scene::TrackedSun& sun) {
   FrameLight out;
   out.row = Row(frame, sun);
-  out.row.decoded = false;
   out.row.status = FrameStatus::kUnreadable;
   const FilteredLight held = filter_.Update(SecondsSinceFirst(frame.utc), std::nullopt, 0.0);
   out.row.light = held.light;

@@ -61,11 +61,12 @@ struct FrameEstimate {
   // whether the sun was up. Sun up with no sunlit sample: E_sun not observed (the estimate holds).
   int sunlit_samples = 0, shadowed_samples = 0;
   bool sun_up = false;
-  bool decoded = true;             // false: the frame could not be decoded (the estimate holds)
   FrameStatus status = FrameStatus::kTooFewSamples;
 
   // False until the first usable fit: the light is all zero before it.
   bool HasEstimate() const { return light.sky_rgb.x + light.sky_rgb.y + light.sky_rgb.z > 0.0; }
+  // False: the frame could not be decoded (the estimate holds).
+  bool Decoded() const { return status != FrameStatus::kUnreadable; }
 };
 
 // What the estimator made of one frame.

@@ -168,9 +168,9 @@ class ChannelFitter {
   //   E_sun = (Σ w x y − Σ_s S_xl·S_ly / S_ll) / (Σ w x² − Σ_s S_xl² / S_ll),
   // the denominator its information; IRLS from `fit` with Reweight's weights. Also the whole-scene
   // model's information on E_sun at the same weights (Σ w x² less its part shared with the clear
-  // sky), and the numerator, for a sun of given colour.
+  // sky), for a sun of given colour.
   struct WithinSurfaces {
-    double sun = 0.0, numerator = 0.0, information = 0.0, scene_information = 0.0;
+    double sun = 0.0, information = 0.0, scene_information = 0.0;
     // How far the surfaces' gains differ: their relative standard deviation (weighted by each
     // surface's S_ll, × K/(K − 1) in variance for K surfaces).
     double gain_spread = 0.0;
@@ -237,10 +237,11 @@ class ChannelFitter {
       for (uint32_t j = 0; j < surfaces; ++j) {
         const Sums& s = sums_[j];
         if (!casting_[j] || !(s[0] > 0.0)) continue;
-        numerator += s[4] - s[1] * s[2] / s[0], information += s[3] - s[1] * s[1] / s[0];
+        const ProfiledSun own = OwnSun(s);
+        numerator += own.numerator, information += own.information;
         scatter += s[5], count += s[6];
       }
-      out.numerator = numerator, out.information = information;
+      out.information = information;
       out.variance = information > 0.0 && count > 0.0 ? scatter / count / information : 0.0;
       const double next = information > 0.0 ? std::max(0.0, numerator / information) : sun;
       for (uint32_t j = 0; j < surfaces; ++j) {
@@ -263,10 +264,10 @@ class ChannelFitter {
     for (uint32_t j = 0; j < surfaces; ++j) {
       const Sums& s = sums_[j];
       if (!casting_[j] || !(s[0] > 0.0)) continue;
-      const double information = s[3] - s[1] * s[1] / s[0];
-      if (!(information > 0.0)) continue;
-      const double own = (s[4] - s[1] * s[2] / s[0]) / information;
-      weight += information, sum_sq += information * (own - out->sun) * (own - out->sun), k += 1.0;
+      const ProfiledSun profiled = OwnSun(s);
+      if (!(profiled.information > 0.0)) continue;
+      const double own = profiled.numerator / profiled.information;
+      weight += profiled.information, sum_sq += profiled.information * (own - out->sun) * (own - out->sun), k += 1.0;
     }
     out->casting_surfaces = static_cast<int>(k);
     if (k >= 2.0 && out->sun > 0.0) out->sun_spread = std::sqrt(sum_sq / weight * k / (k - 1.0)) / out->sun;
@@ -425,6 +426,9 @@ class ChannelFitter {
   std::vector<double> y_, w_, relative_, scratch_, offset_, rest_;  // rest_: y_ less offset_
   // SunWithinSurfaces' buffers: each row's surface, each surface's gain and sums.
   using Sums = std::array<double, 7>;
+  // What one surface's sums (S_ll > 0) know of the sun with its gain profiled out:
+  // S_xy − S_xl·S_ly/S_ll over S_xx − S_xl²/S_ll.
+  static ProfiledSun OwnSun(const Sums& s) { return {s[4] - s[1] * s[2] / s[0], s[3] - s[1] * s[1] / s[0]}; }
   std::vector<uint32_t> surface_of_row_;
   std::vector<uint8_t> casting_;  // per surface: it has both strata
   uint32_t surfaces_ = 0;
@@ -543,9 +547,9 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   std::array<ChannelFit, 3> split_fits{};
   // The fits that ran out of IRLS iterations: the split ones (whose overcast part every channel's
   // final fit takes) and the final ones.
-  int unconverged_fits = 0, fits = 3;
+  int unconverged_fits = 0;
+  const int fits = two_skies ? 6 : 3;
   const double overcast = two_skies ? PooledOvercast(&fitter, samples, usable, &split_fits, &unconverged_fits) : 0.0;
-  fits += two_skies ? 3 : 0;
   // Each channel fitted again with the pooled overcast part given, starting from its split fit's
   // sun and clear sky.
   std::vector<double> spreads, all_residuals, scratch;
@@ -557,7 +561,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   for (const size_t i : usable) several_surfaces = several_surfaces || samples[i].surface != samples[usable[0]].surface;
   const bool from_shadows = options.sun_from_shadows && with_sun && several_surfaces;
   if (from_shadows) fitter.PrepareSurfaces(usable);
-  std::array<double, 3> shadow_weight{0.0, 0.0, 0.0}, mixed_information{0.0, 0.0, 0.0}, mixed_sun{0.0, 0.0, 0.0};
+  std::array<double, 3> mixed_information{0.0, 0.0, 0.0};  // where ρ > 0: what the channel knows of the sun
   double shadow_information = 1.0;  // worst channel, over those where it was needed
   bool shadows_measured = false;
   for (int c = 0; c < 3; ++c) {
@@ -588,14 +592,13 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
                              ? (1.0 - m * m / (spread * spread)) * difference * difference /
                                    (difference * difference + w.variance + model * model)
                              : 0.0;
-      shadow_weight[static_cast<size_t>(c)] = rho;
+      summary.shadow_sun.weight[c] = rho;
       summary.shadow_weight += rho / 3.0;
       if (rho > 0.0) {
         // The clear sky follows the sun at the fit's final weights.
         const double sun = rho * w.sun + (1.0 - rho) * fit[0];
         if (sun > 0.0) {  // relative to the sun given
           const double least = std::max(w.sun_spread * w.sun, model) / sun;
-          summary.shadow_sun.weight[c] = rho;
           summary.shadow_sun.error[c] = std::sqrt(least * least + w.variance / (sun * sun));
           summary.shadow_sun.difference[c] = difference / sun;
         }
@@ -606,7 +609,6 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
         // What the channel knows of the sun, for a sun of given colour: the two informations
         // mixed as the estimates are.
         mixed_information[static_cast<size_t>(c)] = rho * w.information + (1.0 - rho) * w.scene_information;
-        mixed_sun[static_cast<size_t>(c)] = sun;
       }
     }
     scratch.clear();
@@ -627,9 +629,9 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
     for (int c = 0; c < 3; ++c) {
       const NormalEquations& eq = final_equations[static_cast<size_t>(c)];
       const double colour = (*sun_colour)[c];
-      if (shadow_weight[static_cast<size_t>(c)] > 0.0) {  // what the channel knows of the sun, shadows and all
+      if (summary.shadow_sun.weight[c] > 0.0) {  // what the channel knows of the sun, shadows and all
         const double information = mixed_information[static_cast<size_t>(c)];
-        num += colour * mixed_sun[static_cast<size_t>(c)] * information, den += colour * colour * information;
+        num += colour * summary.light.sun_rgb[c] * information, den += colour * colour * information;
         continue;
       }
       if (!(eq.a[1][1] > 0.0)) continue;

@@ -43,7 +43,7 @@ TruthComparison CompareWithTruth(const std::vector<estimation::FrameEstimate>& f
     const auto it = truth_by_frame.find(f.frame);
     cmp.truth.push_back(it == truth_by_frame.end() ? estimation::SunSky{glm::dvec3(NAN), glm::dvec3(NAN)} : it->second);
     cmp.worst_channel_error.push_back(NAN);
-    if (it == truth_by_frame.end() || !f.decoded) continue;
+    if (it == truth_by_frame.end() || !f.Decoded()) continue;
     ++cmp.frames;
     double frame_worst = 0.0;
     for (int k = 0; k < 3; ++k) {
@@ -130,7 +130,7 @@ std::vector<BurstLighting> CompareBursts(const std::vector<estimation::FrameEsti
     r.min_confidence = 1.0;
     for (size_t i = b.begin; i < b.end; ++i) {
       const estimation::FrameEstimate& f = frames[i];
-      if (!f.decoded) continue;
+      if (!f.Decoded()) continue;
       confidence.push_back(f.confidence);
       sunlit.push_back(f.sunlit_samples), shadowed.push_back(f.shadowed_samples);
       r.frames_without_sunlit += f.sun_up && f.sunlit_samples == 0 ? 1 : 0;
