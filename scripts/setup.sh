@@ -23,9 +23,11 @@ packages=(
   libcpp-httplib-dev libspdlog-dev libfmt-dev libtinyobjloader-dev libtinygltf-dev libstb-dev liberfa-dev
 )
 # The tests, benchmarks, sanitizer and fuzz builds, the window tests' X server, the viewer's
-# browser test, the live tests' faked clock, the loaded run's CPU hog.
+# browser test, the live tests' faked clock, the loaded run's CPU hog, the batch workflow's engine
+# (Snakemake, with matplotlib for its plot) and the single-node Slurm its test starts.
 if [ "$main_only" -eq 0 ]; then
-  packages+=(git libgtest-dev libgmock-dev libbenchmark-dev ffmpeg xvfb xauth clang libclang-rt-14-dev chromium faketime stress-ng)
+  packages+=(git libgtest-dev libgmock-dev libbenchmark-dev ffmpeg xvfb xauth clang libclang-rt-14-dev chromium faketime stress-ng
+    snakemake python3-matplotlib slurm-wlm munge)
 fi
 
 missing=()

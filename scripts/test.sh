@@ -4,7 +4,8 @@
 # recordings against the path tracer, which the plain pass runs; under the sanitizers they cost
 # most of CI's time and reach no code the other tests do not) and `browser` (the viewer in
 # Chromium: its JavaScript gains nothing from them; the server's C++ is tested under them by
-# serve/lighting_server_test). --loaded: the same beside a CPU hog on every core (stress-ng), as
+# serve/lighting_server_test) and `batch` (the Snakemake workflow, Python and shell, locally and
+# on Slurm; the daylit commands it runs are tested under them by cli_test). --loaded: the same beside a CPU hog on every core (stress-ng), as
 # on a user's busy laptop: no test may need an idle machine (issue 41).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +21,7 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 export MESA_SHADER_CACHE_DIR="${MESA_SHADER_CACHE_DIR:-$PWD/$build_dir/mesa-cache}"
 filter=()
 if [ "${1:-}" = "--sanitize" ]; then
-  filter=(-LE 'accuracy|browser')
+  filter=(-LE 'accuracy|browser|batch')
   # The recordings' bakes that the plain pass made (build/test-cache) have the same cache key here
   # (the same files, options and bake code), so the fixture loads them instead of baking again
   # under the sanitizers; without them it bakes. The bake's code runs under the sanitizers in
