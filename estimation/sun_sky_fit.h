@@ -48,7 +48,8 @@ glm::vec3 PredictedRadiance(const Sample& s, const LightParts& light);
 
 struct SunSkyFitOptions {
   double cauchy_scale = 0.1;        // relative residual at which a sample's weight halves
-  int iterations = 8;              // IRLS iterations
+  int iterations = 50;             // at most, per IRLS: it stops once the estimate moves less than its
+                                    // tolerance (every frame of courtyard-a, -b, -c and -e within 30)
   double sunlit_threshold = 0.05;   // s·max(0, n·l) above this: a sample that sees the sun well
   int min_stratum_samples = 30;     // per stratum (sunlit, shadowed) for full confidence
   double confident_residual = 0.25; // robust relative residual spread at which confidence is 1/e
