@@ -327,7 +327,7 @@ ShadowObserver::ShadowObserver(const scene::Scene& scene, const bake::SceneBake&
 }
 
 void ShadowObserver::Step(const capture::Frame& frame) {
-  const bool gap = previous_ && !(frame.utc.SecondsSince(*previous_) < capture::kBurstGapS);
+  const bool gap = previous_ && capture::StartsBurst(*previous_, frame.utc);
   const bool cut = previous_ && !gap && options_.max_burst_s > 0.0 && frame.utc.SecondsSince(start_) >= options_.max_burst_s;
   if (gap || cut) CloseBurst();
   if (!previous_ || gap || cut) first_ = frame.index, start_ = frame.utc;

@@ -13,6 +13,16 @@ namespace daylit::capture {
 // start a new one. The estimate's per-burst table and the shadow calibration split alike.
 constexpr double kBurstGapS = 2.0;
 
+// The one rule every per-burst split uses (the report's table, info, the residuals, the split
+// check, the shadow calibration, the sun's colour): a frame at `utc` starts a new burst when it is
+// kBurstGapS or more after the frame before it, or when there was none.
+inline bool StartsBurst(const UtcTime& previous, const UtcTime& utc) {
+  return !(utc.SecondsSince(previous) < kBurstGapS);
+}
+inline bool StartsBurst(const std::optional<UtcTime>& previous, const UtcTime& utc) {
+  return !previous || StartsBurst(*previous, utc);
+}
+
 struct FrameTime {
   int index = 0;
   UtcTime utc;

@@ -38,6 +38,21 @@ TEST(FrameTimesTest, BundledRecordingHas600FramesOverSixBursts) {
   EXPECT_NEAR(times.ExposureOf(0, 1.0), 0.198425, 1e-9);
 }
 
+// The one burst rule: a frame kBurstGapS (2 s) or more after the one before starts a burst, as
+// does the first; a clock that steps back (a camera's clock set) does not. courtyard-a's six.
+TEST(FrameTimesTest, AFrameTwoSecondsOrMoreAfterTheLastStartsABurst) {
+  const UtcTime t = UtcFromUnixSeconds(1.8e9);
+  EXPECT_TRUE(StartsBurst(std::optional<UtcTime>{}, t));
+  EXPECT_FALSE(StartsBurst(t, UtcFromUnixSeconds(1.8e9 + 1.999)));
+  EXPECT_TRUE(StartsBurst(t, UtcFromUnixSeconds(1.8e9 + 2.0)));
+  EXPECT_TRUE(StartsBurst(std::optional<UtcTime>(t), UtcFromUnixSeconds(1.8e9 + 3600.0)));
+  EXPECT_FALSE(StartsBurst(t, UtcFromUnixSeconds(1.8e9 - 10.0)));
+  const FrameTimes times = LoadFrameTimes(DAYLIT_SOURCE_DIR "/recordings/courtyard-a/frames.csv");
+  int bursts = 0;
+  for (size_t i = 0; i < times.frames.size(); ++i) bursts += i == 0 || StartsBurst(times.frames[i - 1].utc, times.frames[i].utc);
+  EXPECT_EQ(bursts, 6);
+}
+
 TEST(FrameTimesTest, OptionalExposureFallsBackToCamera) {
   const FrameTimes times = LoadFrameTimes(
       WriteTemp("ok", "frame,time_utc\n0,2026-06-21T05:00:00Z\n1,2026-06-21T05:00:00.1Z\n"));

@@ -6,7 +6,8 @@
 // sun and sky the objects take from y (as in ObjectShadows). The vertex's irradiance then drops
 // by E_sun·A_sun + E_sky·A_sky with, over its N rays,
 //   A_sun = (1/N) Σ ρ_y cos_y (s_y − s'_y),  A_sky = (1/N) Σ ρ_y ΔV_y
-// (RGB, ρ the surface's albedo from the bake). A_sky once; A_sun when the sun moves 0.05°.
+// (RGB, ρ the surface's albedo from the bake). A_sky once; A_sun when handed another sun direction
+// (scene::SunTracker's: a new one only when the sun moved).
 #pragma once
 
 #include <string>

@@ -17,7 +17,8 @@
 // Without a map it is E_sky times the share of the sky covered. E_reflected is what the objects
 // send back the same directions (SetObjectRadiance, from composite::ObjectLight). ρ is the bake's camera albedo.
 // Embree rays against the objects' meshes: the covered directions once (the objects do not move),
-// the sun whenever it moves by more than 0.05°.
+// the sun whenever it is handed another direction (scene::SunTracker's: a new one only when the sun
+// has moved).
 #pragma once
 
 #include <string>
@@ -52,8 +53,9 @@ class ObjectShadows {
   ObjectShadows(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& real,
                 const scene::RayCaster& objects, const ObjectShadowOptions& options = {});
 
-  // Recasts the sun rays when the sun has moved more than 0.05° since the last cast (or never
-  // was). Returns whether it did.
+  // Recasts the sun rays when `sun_dir` is not the direction of the last cast (or there was none);
+  // the pipeline hands on a new one only when the sun has moved (scene::SunTracker). Returns
+  // whether it did.
   bool SetSun(const glm::vec3& sun_dir);
 
   // The light from the directions the objects cover, per unit of each light, from the relit

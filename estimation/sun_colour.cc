@@ -41,7 +41,7 @@ void SunColourMemory::EndEpisode() {
 }
 
 SunColourMemory::Colour SunColourMemory::At(const UtcTime& utc, double air_mass) {
-  if (!in_episode_ || !(utc.SecondsSince(last_) < capture::kBurstGapS) ||
+  if (!in_episode_ || capture::StartsBurst(last_, utc) ||
       !(utc.SecondsSince(episode_start_) < options_.episode_s)) {
     EndEpisode();
     in_episode_ = true;

@@ -107,10 +107,10 @@ std::filesystem::path ReportPathBeside(const std::filesystem::path& csv) {
   return csv.parent_path() / (csv.stem().string() + "_report.txt");
 }
 
-std::vector<Burst> SplitBursts(const std::vector<estimation::FrameEstimate>& frames, double gap_s) {
+std::vector<Burst> SplitBursts(const std::vector<estimation::FrameEstimate>& frames) {
   std::vector<Burst> bursts;
   for (size_t i = 0; i < frames.size(); ++i) {
-    if (i == 0 || !(frames[i].time_utc.SecondsSince(frames[i - 1].time_utc) < gap_s)) {
+    if (i == 0 || capture::StartsBurst(frames[i - 1].time_utc, frames[i].time_utc)) {
       bursts.push_back({static_cast<int>(bursts.size()), i, i});
     }
     bursts.back().end = i + 1;

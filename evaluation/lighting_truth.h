@@ -48,14 +48,15 @@ struct TruthComparison {
 TruthComparison CompareWithTruth(const std::vector<estimation::FrameEstimate>& frames,
                                  const std::filesystem::path& groundtruth_csv);
 
-// A burst: consecutive frames less than `gap_s` apart (a time-lapse's bursts are hours apart).
+// A burst: consecutive frames less than kBurstGapS apart (capture::StartsBurst; a time-lapse's
+// bursts are hours apart).
 // [begin, end) are positions in the run's frames.
 struct Burst {
   int index = 0;
   size_t begin = 0, end = 0;
 };
 constexpr double kBurstGapS = capture::kBurstGapS;
-std::vector<Burst> SplitBursts(const std::vector<estimation::FrameEstimate>& frames, double gap_s = kBurstGapS);
+std::vector<Burst> SplitBursts(const std::vector<estimation::FrameEstimate>& frames);
 
 // One burst's estimates and, with truth, their errors: medians over its frames of
 // |estimate/truth − 1| per channel (E_sun over frames whose true E_sun is > 0).

@@ -46,7 +46,7 @@ ResidualSink::ResidualSink(const scene::Scene& scene, const bake::SceneBake& bak
 }
 
 void ResidualSink::Consume(const pipeline::PipelineFrame& frame) {
-  if (!last_utc_ || !(frame.frame.utc.SecondsSince(*last_utc_) < capture::kBurstGapS)) {
+  if (capture::StartsBurst(last_utc_, frame.frame.utc)) {
     bursts_.emplace_back(strata_.size());
   }
   last_utc_ = frame.frame.utc;

@@ -133,7 +133,7 @@ SplitCheck::Checked SplitCheck::CheckFrame(const std::vector<estimation::Sample>
 
 void SplitCheck::Add(int frame, const UtcTime& utc, const std::vector<estimation::Sample>& samples,
                      const estimation::SunSkyFitSummary& fit) {
-  if (bursts_.empty() || !(utc.SecondsSince(bursts_.back().last_utc) < capture::kBurstGapS)) {
+  if (bursts_.empty() || capture::StartsBurst(bursts_.back().last_utc, utc)) {
     bursts_.push_back({frame, frame, utc, 0, {}});
   }
   Burst& burst = bursts_.back();

@@ -44,8 +44,9 @@ class EnvRelighter {
   EnvRelighter(const bake::SceneBake& bake, const glm::vec3& capture_position, const scene::RayCaster& caster,
                estimation::TransferOptions options = {});
 
-  // Recomputes the per-texel terms for the unit sun `sun_dir` (scene coordinates) when it moved
-  // more than 0.05°. Returns true if it did.
+  // Recomputes the per-texel terms for the unit sun `sun_dir` (scene coordinates) when it is not
+  // the direction they were last made for (a new one only when the sun has moved:
+  // scene::SunTracker's one rule). Returns true if it did.
   bool SetSun(const glm::vec3& sun_dir);
 
   // The relit radiance of every texel (row-major, like the map): `light` the estimated E_sun

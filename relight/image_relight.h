@@ -86,8 +86,9 @@ class ImageRelighter {
   ImageRelighter(const scene::Scene& scene, const bake::SceneBake& bake, const scene::RayCaster& caster,
                  ImageRelightOptions options = {});
 
-  // The suns of now and of the new light; each one's terms are recomputed when it moved more than
-  // 0.05°. Returns true if either was.
+  // The suns of now and of the new light; each one's terms are recomputed when it is not the
+  // direction they were last made for (the pipeline hands on a new one only when the sun has
+  // moved: scene::SunTracker's one rule). Returns true if either was.
   bool SetSuns(const glm::vec3& now, const glm::vec3& next);
 
   // Multiplies `rgb` (linear, width × height × 3) by E_new / E_now in place (ApplyRatio).

@@ -10,8 +10,8 @@
 //   - 4× MSAA in RGBA32F over transparent black, resolved, read back and blended over the frame
 //     by its coverage (as MSAA over the frame drawn first, without drawing it).
 // Only the rectangle the objects project to is drawn and read back (the rest of the
-// frame is the background as it was), and the sun's shadow map is redrawn only when the sun has
-// moved more than 0.05°.
+// frame is the background as it was), and the sun's shadow map is redrawn only when it is handed
+// another sun direction than the last (a new one only when the sun has moved: scene::SunTracker).
 // Needs a current GL 3.3 core context (render/gl_context.h).
 #pragma once
 

@@ -13,7 +13,7 @@
 # bake there is loaded, not made again. daylit is build/bin/daylit when built here, else the one on PATH.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-usage() { sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 [ $# -ge 2 ] || usage
 recordings=$1 out=$2
 shift 2
@@ -35,6 +35,10 @@ while [ $# -gt 0 ]; do
 done
 if [ ! -d "$recordings" ]; then
   echo "batch: $recordings: no such folder" >&2
+  exit 2
+fi
+if ! compgen -G "$recordings/*/scene.json" >/dev/null; then
+  echo "batch: $recordings holds no recording (a folder with a scene.json)" >&2
   exit 2
 fi
 if ! command -v snakemake >/dev/null 2>&1; then

@@ -11,6 +11,7 @@
 #include "base/csv.h"
 #include "base/error.h"
 #include "base/log.h"
+#include "capture/frame_times.h"
 #include "evaluation/lighting_truth.h"
 #include "capture/video_probe.h"
 #include "scene/envmap_probe.h"
@@ -21,10 +22,6 @@ namespace daylit::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-// A new burst starts where frames are kBurstGapS or more apart, as the estimate's per-burst
-// table splits them (evaluation/lighting_truth.h).
-using evaluation::kBurstGapS;
 
 std::string Relative(const scene::Scene& scene, const fs::path& path) {
   return path.lexically_relative(scene.folder).string();
@@ -117,14 +114,14 @@ std::vector<std::string> PrintFrames(const scene::Scene& scene) {
     if (missing > 0) problems.push_back(fmt::format("{} frame images missing", missing));
   }
   size_t bursts = 1;
-  for (size_t i = 1; i < n; ++i) bursts += times.frames[i].utc.SecondsSince(times.frames[i - 1].utc) >= kBurstGapS;
+  for (size_t i = 1; i < n; ++i) bursts += capture::StartsBurst(times.frames[i - 1].utc, times.frames[i].utc);
   fmt::print("             {}: {} frames, {} -> {} (span {}), {} burst{}\n", Relative(scene, times.file), n,
              FormatUtcTime(times.frames.front().utc), FormatUtcTime(times.frames.back().utc),
              Duration(times.SpanSeconds()), bursts, bursts == 1 ? "" : "s");
   // The sun path: first frame of each burst, and the last frame.
   fmt::print("sun          frame {:>5}  {}\n", 0, SunLine(scene, times.frames.front().utc));
   for (size_t i = 1; i < n; ++i) {
-    if (times.frames[i].utc.SecondsSince(times.frames[i - 1].utc) >= kBurstGapS) {
+    if (capture::StartsBurst(times.frames[i - 1].utc, times.frames[i].utc)) {
       fmt::print("             frame {:>5}  {}\n", i, SunLine(scene, times.frames[i].utc));
     }
   }
