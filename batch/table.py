@@ -52,15 +52,8 @@ def read_json(path):
 
 
 def figure(figures, key):
-    """A figure of daylit's figures.json ("a/b/c" keys, flat or nested), else None."""
-    if key in figures:
-        value = figures[key]
-    else:
-        value = figures
-        for part in key.split("/"):
-            if not isinstance(value, dict) or part not in value:
-                return None
-            value = value[part]
+    """A figure of daylit's figures.json (flat, "a/b/c" keys), else None."""
+    value = figures.get(key)
     return value if isinstance(value, (int, float)) and not isinstance(value, bool) else None
 
 
@@ -80,9 +73,14 @@ def number(text):
     return value if math.isfinite(value) else None
 
 
+def burst_errors(row, quantities=("sun", "sky")):
+    """The burst's |median error| against truth in every channel of `quantities` (none without truth)."""
+    errors = [number(row.get(f"{q}_error_{c}")) for q in quantities for c in "rgb"]
+    return [abs(e) for e in errors if e is not None]
+
+
 def burst_worst_error(row):
-    errors = [number(row.get(f"{q}_error_{c}")) for q in ("sun", "sky") for c in "rgb"]
-    errors = [abs(e) for e in errors if e is not None]
+    errors = burst_errors(row)
     return max(errors) if errors else None
 
 
@@ -175,8 +173,7 @@ def plot(path, rows, bursts_by_recording):
                 width = burst_half_width(b, quantity)
                 if width is not None:
                     ax.bar(x, 100 * width, width=0.6 / n, color="lightsteelblue", edgecolor="steelblue")
-                errors = [number(b.get(f"{quantity}_error_{c}")) for c in "rgb"]
-                errors = [abs(e) for e in errors if e is not None]
+                errors = burst_errors(b, (quantity,))
                 if errors:
                     ax.plot(x, 100 * max(errors), "o", color="black", markersize=4)
         ax.grid(axis="y", alpha=0.3)
