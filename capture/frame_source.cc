@@ -225,6 +225,7 @@ class PacedSource final : public FrameSource {
   }
   std::string Describe() const override { return fmt::format("{}, paced ×{:g}", source_->Describe(), speed_); }
   bool live() const override { return source_->live(); }
+  int waiting() const override { return source_->waiting(); }
 
  private:
   static constexpr double kMaxGapSeconds = 2.0;
@@ -247,6 +248,7 @@ class BorrowedSource final : public FrameSource {
   void Seek(int index) override { source_->Seek(index); }
   std::string Describe() const override { return source_->Describe(); }
   bool live() const override { return source_->live(); }
+  int waiting() const override { return source_->waiting(); }
 
  private:
   FrameSource* source_;
@@ -265,6 +267,7 @@ class ClockShiftedSource final : public FrameSource {
   void Seek(int index) override { source_->Seek(index); }
   std::string Describe() const override { return fmt::format("{}, clock {:+.3f} s", source_->Describe(), seconds_); }
   bool live() const override { return source_->live(); }
+  int waiting() const override { return source_->waiting(); }
 
  private:
   std::unique_ptr<FrameSource> source_;

@@ -54,6 +54,9 @@ class FrameSource {
   virtual void Seek(int index) = 0;
   virtual std::string Describe() const = 0;
   virtual bool live() const { return false; }
+  // Frames already read and waiting for Next() (a read-ahead's queue): a caller that finds one
+  // is behind its source. 0 for a source that reads on demand.
+  virtual int waiting() const { return 0; }
   const SourceStats& stats() const { return stats_; }
 
  protected:

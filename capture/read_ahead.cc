@@ -2,7 +2,9 @@
 
 #include <tbb/concurrent_queue.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cstddef>
 #include <exception>
 #include <thread>
 
@@ -26,6 +28,7 @@ class ReadAheadSource final : public FrameSource {
   ReadAheadSource(std::unique_ptr<FrameSource> source, int depth) : source_(std::move(source)) {
     DAYLIT_CHECK(source_ != nullptr);
     DAYLIT_CHECK(depth >= 1 && depth <= 64, "depth {}", depth);
+    live_ = source_->live();
     queue_.set_capacity(depth);
     thread_ = std::thread([this] { Run(); });
   }
@@ -50,13 +53,17 @@ class ReadAheadSource final : public FrameSource {
     if (next.status == FrameStatus::kEnd) ended_ = true;
     if (next.status == FrameStatus::kFrame) ++stats_.delivered;
     if (next.status == FrameStatus::kUndecodable) ++stats_.undecodable;
-    stats_.dropped = next.dropped, stats_.skipped = next.skipped;
+    stats_.dropped = next.dropped, stats_.skipped = next.skipped + given_up_.load();
     *frame = std::move(next.frame);
     return next.status;
   }
   void Seek(int index) override { DAYLIT_CHECK(false, "Seek({}) on a read-ahead source", index); }
   std::string Describe() const override { return fmt::format("{}, read ahead", source_->Describe()); }
-  bool live() const override { return source_->live(); }
+  bool live() const override { return live_; }
+  // tbb's size() counts pops waiting (negative) and a push waiting on the full queue (one over).
+  int waiting() const override {
+    return static_cast<int>(std::clamp<std::ptrdiff_t>(queue_.size(), 0, queue_.capacity()));
+  }
 
  private:
   void Run() {
@@ -72,7 +79,15 @@ class ReadAheadSource final : public FrameSource {
       }
       const bool last = static_cast<bool>(frame.error) || frame.status == FrameStatus::kEnd;
       try {
-        queue_.push(std::move(frame));  // waits while the caller is `depth` frames behind
+        if (!live_ || last) {
+          queue_.push(std::move(frame));  // waits while the caller is `depth` frames behind
+        } else {
+          // The camera does not wait: the oldest frame waiting makes room for this one.
+          while (!stop_ && !queue_.try_push(std::move(frame))) {
+            DecodedFrame oldest;
+            if (queue_.try_pop(oldest)) ++given_up_;
+          }
+        }
       } catch (const tbb::user_abort&) {
         return;
       }
@@ -81,7 +96,9 @@ class ReadAheadSource final : public FrameSource {
   }
 
   std::unique_ptr<FrameSource> source_;
+  bool live_ = false;  // set before the thread starts
   tbb::concurrent_bounded_queue<DecodedFrame> queue_;
+  std::atomic<int> given_up_{0};  // live: waiting frames given up for newer ones
   std::atomic<bool> stop_{false};
   bool ended_ = false;
   std::thread thread_;  // last: starts once the rest is built

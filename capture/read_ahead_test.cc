@@ -1,8 +1,12 @@
 // capture::ReadAhead: the same frames as the source, in order, with its statuses; a source's
-// error reaches the caller; a read-ahead cannot seek; leaving mid-stream ends the thread.
+// error reaches the caller; a read-ahead cannot seek; leaving mid-stream ends the thread; a live
+// camera is never kept waiting (the oldest waiting frame is given up, counted as skipped).
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <stdexcept>
+#include <thread>
 
 #include "base/check.h"
 #include "capture/read_ahead.h"
@@ -14,8 +18,9 @@ namespace {
 // kWaiting before every third frame, then the end or (with `fail`) an error.
 class CountingSource final : public FrameSource {
  public:
-  CountingSource(int count, int bad, bool fail) : count_(count), bad_(bad), fail_(fail) {}
+  CountingSource(int count, int bad, bool fail, bool live = false) : count_(count), bad_(bad), fail_(fail), live_(live) {}
   FrameStatus Next(Frame* frame) override {
+    ++calls;
     if (next_ % 3 == 0 && !waited_) {
       waited_ = true;
       return FrameStatus::kWaiting;
@@ -31,10 +36,13 @@ class CountingSource final : public FrameSource {
   }
   void Seek(int) override {}
   std::string Describe() const override { return "counting"; }
+  bool live() const override { return live_; }
+
+  std::atomic<int> calls{0};  // Next() calls so far (read by the test's thread)
 
  private:
   int count_, bad_;
-  bool fail_;
+  bool fail_, live_;
   int next_ = 0;
   bool waited_ = false;
 };
@@ -70,6 +78,44 @@ TEST(ReadAheadTest, SeekIsABrokenInvariantAndLeavingEarlyEndsTheThread) {
   ASSERT_EQ(source->Next(&frame), FrameStatus::kFrame);
   EXPECT_THROW(source->Seek(3), InvariantError);
   source.reset();  // a reader blocked on the full queue must not hang the destructor
+}
+
+// A camera does not wait for its reader: with the reader away, the read-ahead goes on taking
+// every frame (a driver would otherwise drop them for want of a queued buffer), keeps the newest
+// `depth` and counts the others as skipped. A recording's read-ahead waits instead.
+TEST(ReadAheadTest, ALiveSourceIsReadToTheEndWhileItsReaderIsAwayKeepingTheNewest) {
+  constexpr int kFrames = 40, kDepth = 4;
+  for (const bool live : {true, false}) {
+    auto counting = std::make_unique<CountingSource>(kFrames, -1, false, live);
+    const CountingSource* watched = counting.get();
+    std::unique_ptr<FrameSource> source = ReadAhead(std::move(counting), kDepth);
+    // Every Next() the source needs: the frames, the kWaiting before every third, the end.
+    const int all_calls = kFrames + (kFrames + 2) / 3 + 1;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (watched->calls.load() < all_calls && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(live ? 5 : 200));
+      if (!live) break;  // a recording's reader stops at a full queue: give it a moment, no more
+    }
+    Frame frame;
+    if (live) {
+      ASSERT_EQ(watched->calls.load(), all_calls) << "the live source was kept waiting";
+      EXPECT_EQ(source->waiting(), kDepth);
+      for (int i = kFrames - kDepth; i < kFrames; ++i) {
+        ASSERT_EQ(source->Next(&frame), FrameStatus::kFrame);
+        EXPECT_EQ(frame.index, i) << "the newest frames, in order";
+      }
+      EXPECT_EQ(source->Next(&frame), FrameStatus::kEnd);
+      EXPECT_EQ(source->stats().skipped, kFrames - kDepth);
+    } else {
+      EXPECT_LT(watched->calls.load(), all_calls);
+      for (int i = 0; i < kFrames; ++i) {
+        ASSERT_EQ(source->Next(&frame), FrameStatus::kFrame);
+        EXPECT_EQ(frame.index, i) << "every frame, in order";
+      }
+      EXPECT_EQ(source->Next(&frame), FrameStatus::kEnd);
+      EXPECT_EQ(source->stats().skipped, 0);
+    }
+  }
 }
 
 }  // namespace

@@ -43,11 +43,27 @@ bool LightingPipeline::StopRequested() const {
 
 PipelineRun LightingPipeline::Run(std::unique_ptr<capture::FrameSource> source) {
   DAYLIT_CHECK(video_ == nullptr || stage_ != nullptr, "a video needs a stage that makes its images");
-  // A camera's frames are decoded one ahead at most: a deeper queue is only lag.
-  const bool live = source->live();
-  std::unique_ptr<capture::FrameSource> frames = capture::ReadAhead(std::move(source), live ? 1 : 4);
+  // The set-up comes first: a camera streams from the read-ahead's first frame on. For a camera,
+  // that includes the stage's first composite (its sun-dependent parts for the sun of now, which
+  // the first frames will have, and its GL programs): a second or more with software GL. The
+  // estimator's first frame is left as it is (a few hundred ms, within the read-ahead's queue):
+  // its estimates are a recording's, whatever the sun before it.
   scene::SunTracker sun_tracker(scene_, options_.sun);
   estimation::FrameEstimator estimator(scene_, bake_, caster_, options_.estimator);
+  const bool live = source->live();
+  if (live) {
+    timespec now{};
+    ::clock_gettime(CLOCK_REALTIME, &now);
+    const scene::TrackedSun& sun =
+        sun_tracker.Update(UtcFromUnixSeconds(static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec)));
+    if (stage_ != nullptr) stage_->Prepare(sun);
+  }
+  // A camera's read-ahead never keeps it waiting (the driver would drop frames); its queue holds
+  // what arrives during a slow frame (a sun move: a few hundred ms) so that every frame is still
+  // estimated: up to kLiveQueueBytes of frames, the most lag.
+  const size_t frame_bytes = static_cast<size_t>(bake_.camera.width) * static_cast<size_t>(bake_.camera.height) * 3 * sizeof(float);
+  const int live_depth = static_cast<int>(std::clamp<size_t>(kLiveQueueBytes / std::max<size_t>(frame_bytes, 1), 4, 64));
+  std::unique_ptr<capture::FrameSource> frames = capture::ReadAhead(std::move(source), live ? live_depth : 4);
   PipelineRun run;
   // A recording's length is known; a live camera's is max_frames, else until stopped.
   std::optional<size_t> total;
@@ -84,8 +100,15 @@ PipelineRun LightingPipeline::Run(std::unique_ptr<capture::FrameSource> source) 
     }
     run.frames.push_back(light.row);
     if (!options_.first_output_frame || frame.index >= *options_.first_output_frame) {
-      const double ms = Deliver(frame, light, sun);
-      if (ms >= 0.0) stage_ms.push_back(ms);
+      // Behind a camera (a newer frame already waits), the estimate is all this frame gets: its
+      // image is the last one again, so that the camera is never outrun.
+      const bool behind = live && readable && stage_ != nullptr && run.composited > 0 && frames->waiting() > 0;
+      if (behind) ++run.composites_skipped;
+      const double ms = Deliver(frame, light, sun, !behind);
+      if (ms >= 0.0) {
+        stage_ms.push_back(ms);
+        ++run.composited;
+      }
     }
     const double fps = static_cast<double>(i + 1) / std::max(std::chrono::duration<double>(Clock::now() - start).count(), 1e-9);
     if (progress) {
@@ -105,11 +128,11 @@ PipelineRun LightingPipeline::Run(std::unique_ptr<capture::FrameSource> source) 
 }
 
 double LightingPipeline::Deliver(const capture::Frame& frame, const estimation::FrameLight& light,
-                                 const scene::TrackedSun& sun) {
+                                 const scene::TrackedSun& sun, bool image) {
   const bool readable = !frame.rgb.empty();
   double ms = -1.0;
   PipelineFrame out{frame, light, sun};
-  if (stage_ != nullptr && readable) {
+  if (stage_ != nullptr && readable && image) {
     if (video_ != nullptr) image_ = video_->TakeBuffer();
     const Clock::time_point t0 = Clock::now();
     out.image_light = stage_->Process(frame, light, sun, &image_);
@@ -118,8 +141,9 @@ double LightingPipeline::Deliver(const capture::Frame& frame, const estimation::
   }
   for (FrameSink* sink : sinks_) sink->Consume(out);
   if (video_ != nullptr) {
-    // A frame that could not be read shows the last one again, so the video keeps its timing.
-    video_->Write(readable ? std::move(image_) : std::vector<float>{}, frame.exposure);
+    // A frame that could not be read, or had no image made, shows the last one again, so the
+    // video keeps its timing.
+    video_->Write(out.image != nullptr ? std::move(image_) : std::vector<float>{}, frame.exposure);
     image_.clear();
   }
   return ms;

@@ -45,6 +45,9 @@ class FrameStage {
   // `image` is resized by the stage to width × height × 3; it may hold the previous frame's.
   virtual ImageLight Process(const capture::Frame& frame, const estimation::FrameLight& light,
                              const scene::TrackedSun& sun, std::vector<float>* image) = 0;
+  // Before a live camera's first frame: the one-time and sun-dependent work for `sun`, so that
+  // the first frames do not wait for it. Optional.
+  virtual void Prepare(const scene::TrackedSun& /*sun*/) {}
 };
 
 struct PipelineRun;
@@ -76,7 +79,11 @@ struct PipelineRun {
   std::vector<estimation::FrameEstimate> frames;  // every frame read, in order
   int undecodable = 0;
   int dropped = 0;  // a live camera: frames its driver's sequence numbers show were never delivered
-  int skipped = 0;  // a live camera: frames given back unread because a newer one was waiting
+  int skipped = 0;  // a live camera: frames given up unread because newer ones were waiting
+  // With a stage: frames whose image was made, and a live camera's frames that had only their
+  // estimate because a newer one was already waiting (their image is the last one again).
+  int composited = 0;
+  int composites_skipped = 0;
   // A live camera: each frame's age when its estimate was done (wall clock minus its capture
   // instant), ms: how far the pipeline runs behind the camera.
   std::vector<double> latency_ms;
@@ -102,12 +109,21 @@ class LightingPipeline {
 
   // Runs over `source` until its end, `max_frames`, `stop` or a sink's stop. A frame that cannot
   // be read holds the estimate; while a camera is unplugged nothing comes and the estimate holds.
+  // A live camera is never kept waiting: every frame it delivers is estimated, and while a newer
+  // one waits the stage is left out (composites_skipped); only behind by more than the
+  // read-ahead's queue (kLiveQueueBytes) are frames given up unestimated (skipped). Before the
+  // camera's first frame, the stage is prepared for the sun of now (FrameStage::Prepare).
   PipelineRun Run(std::unique_ptr<capture::FrameSource> source);
 
  private:
   bool StopRequested() const;
-  // The stage, the sinks and the video for one frame; the stage's time in ms, or < 0 without one.
-  double Deliver(const capture::Frame& frame, const estimation::FrameLight& light, const scene::TrackedSun& sun);
+  // The stage (if `image`), the sinks and the video for one frame; the stage's time in ms, or < 0
+  // without one.
+  double Deliver(const capture::Frame& frame, const estimation::FrameLight& light, const scene::TrackedSun& sun,
+                 bool image);
+
+  // A live camera's read-ahead queue: 256 MiB of frames (41 at 960×540, 10 at 1920×1080), 4 to 64.
+  static constexpr size_t kLiveQueueBytes = size_t{256} << 20;
 
   const scene::Scene& scene_;
   const bake::SceneBake& bake_;

@@ -10,6 +10,11 @@ CompositeStage::CompositeStage(const scene::Scene& scene, const bake::SceneBake&
                                render::FrameRenderer* renderer, const render::TimeSlider* slider)
     : scene_(scene), bake_(bake), caster_(caster), renderer_(*renderer), slider_(slider) {}
 
+void CompositeStage::Prepare(const scene::TrackedSun& sun) {
+  std::vector<float> black(static_cast<size_t>(renderer_.width()) * static_cast<size_t>(renderer_.height()) * 3, 0.0f);
+  renderer_.RenderLinear({}, 0.0, sun.dir_in_scene, black.data());
+}
+
 ImageLight CompositeStage::Process(const capture::Frame& frame, const estimation::FrameLight& light,
                                    const scene::TrackedSun& sun, std::vector<float>* image) {
   const estimation::FrameEstimate& row = light.row;

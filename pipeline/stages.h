@@ -25,6 +25,9 @@ class CompositeStage final : public FrameStage {
                  render::FrameRenderer* renderer, const render::TimeSlider* slider = nullptr);
   ImageLight Process(const capture::Frame& frame, const estimation::FrameLight& light, const scene::TrackedSun& sun,
                      std::vector<float>* image) override;
+  // One composite of a black frame under no light: the renderer's sun-dependent parts, its GL
+  // programs and buffers made.
+  void Prepare(const scene::TrackedSun& sun) override;
 
  private:
   const scene::Scene& scene_;

@@ -77,7 +77,7 @@ sed -z 's|"frames": {[^}]*}|"frames": {"device": "/dev/video-daylit-results", "f
   recordings/courtyard-a/scene.json >"$live/scene.json"
 LD_PRELOAD="$PWD/build/tests/libdaylit_fakecam.so" DAYLIT_FAKECAM_DEVICE=/dev/video-daylit-results \
   DAYLIT_FAKECAM_VIDEO=recordings/courtyard-a/video.mp4 DAYLIT_FAKECAM_FRAMES=60 DAYLIT_FAKECAM_FORMATS=YUYV \
-  "$daylit" -q live --scene "$live/scene.json" --cache "build/results-cache/live" --frames 300 \
+  "$daylit" -q live --scene "$live/scene.json" --cache "build/results-cache/live" --frames 600 \
   --out "$live/live.mp4" >/dev/null
 
 # Seed 002's benchmark on the five lat-long probes (docs/relight.md).

@@ -160,6 +160,9 @@ TEST(LiveDeviceTest, LiveCountsDroppedFramesAndSurvivesAnUnplug) {
   EXPECT_EQ(count("auto exposure off (manual); reads back 1"), 2u) << "controls set at the start and again after the unplug\n" << run.err;
   const nlohmann::json figures = nlohmann::json::parse(ReadTextFile(out / "figures.json"));
   EXPECT_EQ(figures.at("frames").get<int>(), 40);
+  // Every frame estimated; each composited, or (a newer frame waiting) estimated only.
+  EXPECT_EQ(figures.at("composited").get<int>() + figures.at("composites_skipped").get<int>(), 40);
+  EXPECT_GE(figures.at("composited").get<int>(), 1);
   // daylit's count is the gaps in the sequence numbers of the frames it took, in the order the
   // device handed them out (a new stream after the unplug starts again at 0). They include
   // every 7th sensor frame (lost on purpose) and any the device lost for want of a queued buffer

@@ -220,13 +220,26 @@ void WriteReplayReport(const scene::Scene& scene, const pipeline::PipelineRun& r
     const double median = PercentileInPlace(latency, 0.5, static_cast<double>(NAN)),
                  p95 = PercentileInPlace(latency, 0.95, static_cast<double>(NAN)),
                  worst = PercentileInPlace(latency, 1.0, static_cast<double>(NAN));
-    report.Say(fmt::format("  {} frames dropped by the camera's driver (gaps in its sequence numbers), {} skipped "
-                           "(a newer one was waiting); a frame's age when estimated: median {:.0f} ms, 95th percentile "
-                           "{:.0f} ms, worst {:.0f} ms (the first frame waits for the set-up)",
+    report.Say(fmt::format("  {} frames dropped by the camera's driver (gaps in its sequence numbers), {} given up "
+                           "unestimated (the read-ahead's queue full: over a second behind at 960x540); a frame's age when estimated: median {:.0f} ms, "
+                           "95th percentile {:.0f} ms, worst {:.0f} ms (the first frame waits for the set-up)",
                            run.dropped, run.skipped, median, p95, worst));
+    const int made = run.composited + run.composites_skipped;
+    report.Say(fmt::format("  composited {} of {} frames; {} estimated only, their image the one before, because "
+                           "a newer frame was already waiting (the machine slower than the camera){}",
+                           run.composited, made, run.composites_skipped,
+                           run.composites_skipped > 0 ? fmt::format(": {:.1f} composites a second",
+                                                                    run.composited / std::max(run.seconds, 1e-9))
+                                                      : std::string()));
+    if (made > 0 && run.composites_skipped * 10 > made) {
+      Log().warn("composited only {} of {} frames: the machine is slower than the camera (a smaller camera "
+                 "resolution or frame rate in scene.json composites every frame)", run.composited, made);
+    }
     report.Figure("latency_p95_ms", p95);
     report.Figure("dropped", run.dropped);
     report.Figure("skipped", run.skipped);
+    report.Figure("composited", run.composited);
+    report.Figure("composites_skipped", run.composites_skipped);
     report.Figure("latency_median_ms", median);
     report.Figure("latency_worst_ms", worst);
   }
