@@ -75,7 +75,10 @@ mkdir -p "$live"
 cp recordings/courtyard-a/model.obj recordings/courtyard-a/envmap.exr "$live/"
 sed -z 's|"frames": {[^}]*}|"frames": {"device": "/dev/video-daylit-results", "fps": 30}|; s|,[[:space:]]*"groundtruth": {[^}]*}||' \
   recordings/courtyard-a/scene.json >"$live/scene.json"
-LD_PRELOAD="$PWD/build/tests/libdaylit_fakecam.so" DAYLIT_FAKECAM_DEVICE=/dev/video-daylit-results \
+# The clock (libfaketime) at the recording's own time of day, so that the sun its frames show is up
+# and moves as they were recorded.
+LD_PRELOAD="$PWD/build/tests/libdaylit_fakecam.so /usr/lib/x86_64-linux-gnu/faketime/libfaketimeMT.so.1" \
+  FAKETIME="@2026-06-21 05:00:00" DAYLIT_FAKECAM_DEVICE=/dev/video-daylit-results \
   DAYLIT_FAKECAM_VIDEO=recordings/courtyard-a/video.mp4 DAYLIT_FAKECAM_FRAMES=60 DAYLIT_FAKECAM_FORMATS=YUYV \
   "$daylit" -q live --scene "$live/scene.json" --cache "build/results-cache/live" --frames 600 \
   --out "$live/live.mp4" >/dev/null
