@@ -349,16 +349,21 @@ class ChannelFitter {
     }
   }
 
-  // The weighted normal equations of the samples with the weights in w_ (all three regressors;
-  // an unused one is zero) for the radiance less its known part, vectorised by Eigen.
+  // The weighted normal equations of the samples with the weights in w_ for the radiance less its
+  // known part, vectorised by Eigen. Without the split the third regressor is all zero (Load):
+  // its sums are left at zero, the same numbers for a third less work.
   NormalEquations Equations() {
     const Eigen::Map<Eigen::ArrayXd> ey = Column(rest_), ex0 = Column(x_[0]), ex1 = Column(x_[1]), ex2 = Column(x_[2]);
     const Eigen::Map<Eigen::ArrayXd> ew = Column(w_);
     NormalEquations eq;
-    const Eigen::ArrayXd w0 = ew * ex0, w1 = ew * ex1, w2 = ew * ex2;
-    eq.a[0][0] = (w0 * ex0).sum(), eq.a[0][1] = (w0 * ex1).sum(), eq.a[0][2] = (w0 * ex2).sum();
-    eq.a[1][1] = (w1 * ex1).sum(), eq.a[1][2] = (w1 * ex2).sum(), eq.a[2][2] = (w2 * ex2).sum();
-    eq.b[0] = (w0 * ey).sum(), eq.b[1] = (w1 * ey).sum(), eq.b[2] = (w2 * ey).sum();
+    w0_ = ew * ex0, w1_ = ew * ex1;
+    eq.a[0][0] = (w0_ * ex0).sum(), eq.a[0][1] = (w0_ * ex1).sum(), eq.a[1][1] = (w1_ * ex1).sum();
+    eq.b[0] = (w0_ * ey).sum(), eq.b[1] = (w1_ * ey).sum();
+    if (free_[2]) {
+      w2_ = ew * ex2;
+      eq.a[0][2] = (w0_ * ex2).sum(), eq.a[1][2] = (w1_ * ex2).sum(), eq.a[2][2] = (w2_ * ex2).sum();
+      eq.b[2] = (w2_ * ey).sum();
+    }
     eq.yy = (ew * ey.square()).sum();
     eq.a[1][0] = eq.a[0][1], eq.a[2][0] = eq.a[0][2], eq.a[2][1] = eq.a[1][2];
     return eq;
@@ -406,9 +411,12 @@ class ChannelFitter {
     for (int iteration = 0; iteration < options_.iterations && !converged_; ++iteration) {
       // Least squares on relative residuals: 1/scale² times the Cauchy weight 1/(1 + r²), that
       // is 1/(scale² + d²/c²) for a residual d.
-      const Eigen::ArrayXd prediction = eoffset + ex0 * fit[0] + ex1 * fit[1] + ex2 * fit[2];
-      const Eigen::ArrayXd d = ey - prediction;
-      ew = (prediction.max(floor_).square() + d.square() * (inv_scale * inv_scale)).inverse();
+      if (free_[2]) {
+        prediction_ = eoffset + ex0 * fit[0] + ex1 * fit[1] + ex2 * fit[2];
+      } else {
+        prediction_ = eoffset + ex0 * fit[0] + ex1 * fit[1];  // x_[2] is zero
+      }
+      ew = (prediction_.max(floor_).square() + (ey - prediction_).square() * (inv_scale * inv_scale)).inverse();
       const ChannelFit next = SolveNonNegative(Equations(), free_);
       double change = 0.0;
       const double size = std::max({next[0], next[1] + next[2], 1e-30});
@@ -441,6 +449,7 @@ class ChannelFitter {
   std::vector<uint8_t> row_in_medians_;  // the same per loaded row
   double floor_ = 0.0;
   bool converged_ = false;
+  Eigen::ArrayXd prediction_, w0_, w1_, w2_;  // Reweight's and Equations' buffers, kept between fits
 };
 
 // The overcast part of the sky is grey, one value for all channels (lighting_model.h): fitted
