@@ -158,6 +158,7 @@ class ChannelFitter {
   // After Fit: the samples' residuals relative to the prediction, in the order of `rows`.
   const std::vector<double>& relative() const { return relative_; }
   bool converged() const { return converged_; }
+  int steps() const { return steps_; }  // reweighting steps over every fit so far
   // The normal equations at the last fit's final weights (for the channel it was loaded with).
   NormalEquations FinalEquations() { return Equations(); }
 
@@ -393,8 +394,9 @@ class ChannelFitter {
   }
 
   // IRLS from `fit`: Cauchy weights on residuals relative to the prediction, floored at a tenth
-  // of the start's median prediction so that near-black points do not dominate; until the
-  // estimate moves less than a tolerance (relative). The split only feeds the pooled overcast
+  // of the start's median prediction so that near-black points do not dominate; until a step
+  // moves the estimate less than a tolerance (relative), the step from the point its weights were
+  // taken at (a fixed point's test, accelerated or not). The split only feeds the pooled overcast
   // share, so it stops sooner.
   ChannelFit Reweight(ChannelFit fit, bool split) {
     scratch_.clear();
@@ -408,21 +410,53 @@ class ChannelFitter {
     Eigen::Map<Eigen::ArrayXd> ew = Column(w_);
     const double tolerance = split ? 1e-3 : 1e-4;
     converged_ = false;
+    ChannelFit at = fit;  // where the weights are taken
+    ChannelFit last_step{}, last_next{};
+    bool have_last = false;
     for (int iteration = 0; iteration < options_.iterations && !converged_; ++iteration) {
       // Least squares on relative residuals: 1/scale² times the Cauchy weight 1/(1 + r²), that
       // is 1/(scale² + d²/c²) for a residual d.
       if (free_[2]) {
-        prediction_ = eoffset + ex0 * fit[0] + ex1 * fit[1] + ex2 * fit[2];
+        prediction_ = eoffset + ex0 * at[0] + ex1 * at[1] + ex2 * at[2];
       } else {
-        prediction_ = eoffset + ex0 * fit[0] + ex1 * fit[1];  // x_[2] is zero
+        prediction_ = eoffset + ex0 * at[0] + ex1 * at[1];  // x_[2] is zero
       }
       ew = (prediction_.max(floor_).square() + (ey - prediction_).square() * (inv_scale * inv_scale)).inverse();
       const ChannelFit next = SolveNonNegative(Equations(), free_);
       double change = 0.0;
       const double size = std::max({next[0], next[1] + next[2], 1e-30});
-      for (size_t j = 0; j < 3; ++j) change = std::max(change, std::abs(next[j] - fit[j]) / size);
+      for (size_t j = 0; j < 3; ++j) change = std::max(change, std::abs(next[j] - at[j]) / size);
       fit = next;
       converged_ = change < tolerance;
+      ++steps_;
+      if (converged_ || !options_.accelerate) {
+        at = next;
+        continue;
+      }
+      // Anderson acceleration of depth 1 (Walker & Ni, SIAM J. Numer. Anal. 49, 2011): the next
+      // point is the combination of the last two steps' results that best cancels their steps;
+      // a point outside the non-negative set, or no step change to go by, takes the plain step.
+      ChannelFit step{};
+      for (size_t j = 0; j < 3; ++j) step[j] = next[j] - at[j];
+      at = next;
+      if (have_last) {
+        double df_f = 0.0, df_df = 0.0;
+        for (size_t j = 0; j < 3; ++j) {
+          const double df = step[j] - last_step[j];
+          df_f += df * step[j], df_df += df * df;
+        }
+        if (df_df > 0.0) {
+          const double gamma = df_f / df_df;
+          ChannelFit mixed{};
+          bool inside = std::isfinite(gamma);
+          for (size_t j = 0; j < 3; ++j) {
+            mixed[j] = next[j] - gamma * (next[j] - last_next[j]);
+            inside = inside && mixed[j] >= 0.0;
+          }
+          if (inside) at = mixed;
+        }
+      }
+      last_step = step, last_next = next, have_last = true;
     }
     return fit;
   }
@@ -449,6 +483,7 @@ class ChannelFitter {
   std::vector<uint8_t> row_in_medians_;  // the same per loaded row
   double floor_ = 0.0;
   bool converged_ = false;
+  int steps_ = 0;  // reweighting steps over every fit
   Eigen::ArrayXd prediction_, w0_, w1_, w2_;  // Reweight's and Equations' buffers, kept between fits
 };
 
@@ -670,6 +705,7 @@ SunSkyFitSummary FitSunSky(const SunSkyFitOptions& options, const std::vector<Sa
   summary.inlier_share = static_cast<double>(inliers) / static_cast<double>(all_residuals.size());
   SplitShares(options, samples, usable, &summary);
   summary.confidence = Confidence(options, summary, with_sun);
+  summary.reweighting_steps = fitter.steps();
   summary.status = unconverged_fits > 0 ? SunSkyFitStatus::kNoConvergence
                    : with_sun                ? SunSkyFitStatus::kConverged
                                              : SunSkyFitStatus::kSkyOnly;

@@ -50,6 +50,8 @@ struct SunSkyFitOptions {
   double cauchy_scale = 0.1;        // relative residual at which a sample's weight halves
   int iterations = 50;             // at most, per IRLS: it stops once the estimate moves less than its
                                     // tolerance (every frame of courtyard-a, -b, -c and -e within 30)
+  bool accelerate = true;           // each reweighting step Anderson-accelerated (depth 1): the same
+                                    // answer in two thirds of the steps; off: plain IRLS
   double sunlit_threshold = 0.05;   // s·max(0, n·l) above this: a sample that sees the sun well
   int min_stratum_samples = 30;     // per stratum (sunlit, shadowed) for full confidence
   double confident_residual = 0.25; // robust relative residual spread at which confidence is 1/e
@@ -105,6 +107,7 @@ struct SunSkyFitSummary {
   // confidence 0, and the temporal filter holds the last estimate that had it.
   bool sun_up = false;
   double inlier_share = 0.0;    // samples with |relative residual| < 3·cauchy_scale
+  int reweighting_steps = 0;    // IRLS steps over every channel's fits (the cost)
   // How well the sun/sky split is posed, from the fitted light (worst channel): the share of the
   // sunlit samples' predicted light that is direct sun, and of the shadowed samples' that is sky
   // (1 without such samples). A stratum lit mostly by the other term passes that term's model

@@ -281,6 +281,7 @@ TEST(SunSkyFitTest, TheReweightingRunsUntilTheEstimateStopsMoving) {
   const SunSkyFitSummary fit = FitSunSky({}, samples), optimum = FitSunSky(many, samples);
   SunSkyFitOptions eight;
   eight.iterations = 8;
+  eight.accelerate = false;
   const SunSkyFitSummary cut = FitSunSky(eight, samples);
   EXPECT_EQ(fit.status, SunSkyFitStatus::kConverged) << fit.message;
   double off_cut = 0.0;
@@ -292,6 +293,41 @@ TEST(SunSkyFitTest, TheReweightingRunsUntilTheEstimateStopsMoving) {
   }
   EXPECT_EQ(cut.status, SunSkyFitStatus::kNoConvergence);
   EXPECT_GT(off_cut, 0.03);
+}
+
+// The acceleration of the reweighting (Anderson, depth 1) changes the path, not the answer: on
+// the same disagreeing samples, and on clean ones, the accelerated fit is within 0.1% of the
+// optimum (the plain reweighting run 1000 steps), in fewer steps than the plain one where the
+// weights settle slowly.
+TEST(SunSkyFitTest, TheAcceleratedReweightingReachesTheSameAnswerInFewerSteps) {
+  for (const bool disagree : {false, true}) {
+    std::mt19937 rng(11);
+    std::vector<Sample> samples = MakeSamples(kClear, 5000, rng);
+    std::uniform_real_distribution<float> wild(0.0f, 40.0f);
+    for (size_t i = 0; i < samples.size(); i += 10) samples[i].radiance = {wild(rng), wild(rng), wild(rng)};
+    if (disagree) {
+      for (size_t i = 1000; i < 3000; ++i) samples[i].radiance *= samples[i].sunlit ? 1.5f : 1.0f / 1.5f;
+    }
+    SunSkyFitOptions plain, many;
+    plain.accelerate = false;
+    many.accelerate = false;
+    many.iterations = 1000;
+    const SunSkyFitSummary fast = FitSunSky({}, samples), slow = FitSunSky(plain, samples), optimum = FitSunSky(many, samples);
+    std::printf("%s: %d steps accelerated, %d plain\n", disagree ? "40% disagreeing" : "clean", fast.reweighting_steps,
+                slow.reweighting_steps);
+    EXPECT_EQ(fast.status, SunSkyFitStatus::kConverged) << fast.message;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(fast.light.sun_rgb[c] / optimum.light.sun_rgb[c], 1.0, 1e-3) << c;
+      EXPECT_NEAR(fast.light.sky_rgb[c] / optimum.light.sky_rgb[c], 1.0, 1e-3) << c;
+    }
+    // Clean samples settle in 3 steps a channel, with nothing to gain; disagreeing ones in 19
+    // against 22 here (6.3 -> 4.2 a fit over courtyard-a's frames, docs/estimation.md).
+    if (disagree) {
+      EXPECT_LT(fast.reweighting_steps, slow.reweighting_steps);
+    } else {
+      EXPECT_LE(fast.reweighting_steps, slow.reweighting_steps);
+    }
+  }
 }
 
 TEST(SunSkyFitTest, OvercastGivesNoSunWithConfidence) {
