@@ -132,6 +132,7 @@ double LightingPipeline::Deliver(const capture::Frame& frame, const estimation::
   const bool readable = !frame.rgb.empty();
   double ms = -1.0;
   PipelineFrame out{frame, light, sun};
+  if (stage_ != nullptr && readable && !image) stage_->Skip(light);
   if (stage_ != nullptr && readable && image) {
     if (video_ != nullptr) image_ = video_->TakeBuffer();
     const Clock::time_point t0 = Clock::now();

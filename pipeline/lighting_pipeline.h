@@ -48,6 +48,9 @@ class FrameStage {
   // Before a live camera's first frame: the one-time and sun-dependent work for `sun`, so that
   // the first frames do not wait for it. Optional.
   virtual void Prepare(const scene::TrackedSun& /*sun*/) {}
+  // A readable frame whose image is left out (a live camera's while the pipeline is behind):
+  // whatever cheap state the sinks read should follow its light. Optional.
+  virtual void Skip(const estimation::FrameLight& /*light*/) {}
 };
 
 struct PipelineRun;

@@ -15,6 +15,10 @@ void CompositeStage::Prepare(const scene::TrackedSun& sun) {
   renderer_.RenderLinear({}, 0.0, sun.dir_in_scene, black.data());
 }
 
+void CompositeStage::Skip(const estimation::FrameLight& light) {
+  renderer_.FollowLight(light.row.light, light.overcast_share);
+}
+
 ImageLight CompositeStage::Process(const capture::Frame& frame, const estimation::FrameLight& light,
                                    const scene::TrackedSun& sun, std::vector<float>* image) {
   const estimation::FrameEstimate& row = light.row;

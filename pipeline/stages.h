@@ -28,6 +28,9 @@ class CompositeStage final : public FrameStage {
   // One composite of a black frame under no light: the renderer's sun-dependent parts, its GL
   // programs and buffers made.
   void Prepare(const scene::TrackedSun& sun) override;
+  // The renderer's irradiance volume follows the frame's light (FrameRenderer::FollowLight), so
+  // that what the lighting server publishes is this frame's.
+  void Skip(const estimation::FrameLight& light) override;
 
  private:
   const scene::Scene& scene_;

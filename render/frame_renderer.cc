@@ -107,6 +107,12 @@ void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcas
   compositor_.Render(input, image);
 }
 
+void FrameRenderer::FollowLight(const estimation::SunSky& light, double overcast_share) {
+  if (!volume_ || env_lights_ || volume_parts_[0].empty()) return;  // no volume, or none made yet
+  const estimation::LightParts e = estimation::SplitLight(light, overcast_share);
+  volume_->SetCombination({&volume_parts_[0], &volume_parts_[1], &volume_parts_[2]}, {e.sun, e.clear, e.overcast});
+}
+
 void FrameRenderer::UpdateObjectLight(const glm::vec3& sun_dir) {
   // Each side's indirect light, part by part, from the volume (none without one).
   const std::vector<glm::vec3>& points = object_light_.points();

@@ -52,6 +52,11 @@ class FrameRenderer {
   // relit frame, say (relight::ImageRelighter).
   void RenderLinear(const estimation::SunSky& light, double overcast_share, const glm::vec3& sun_dir, float* image);
 
+  // A frame without a composite (a live camera's while the pipeline is behind): the irradiance
+  // volume follows `light` as Render would leave it, from the parts made for the last sun, at
+  // the cost of one weighted sum (volume() then reads it). No GL.
+  void FollowLight(const estimation::SunSky& light, double overcast_share);
+
   // The frame linearised in radiance units, as Render starts from (for comparisons).
   void Linearize(const capture::Frame& frame, std::vector<float>* linear) const;
   const composite::ObjectShadows& shadows() const { return shadows_; }

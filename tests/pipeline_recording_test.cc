@@ -204,6 +204,8 @@ class SlowStage final : public FrameStage {
     image->assign(rgb, rgb + frame.rgb.total() * 3);
     return ImageLight::kFrameLight;
   }
+  void Skip(const estimation::FrameLight&) override { ++skips; }
+  int skips = 0;
 
  private:
   double seconds_;
@@ -263,6 +265,7 @@ TEST(PipelineRecordingTest, BehindALiveCameraEveryFrameIsEstimatedAndSomeComposi
   ASSERT_EQ(sink.frames.size(), static_cast<size_t>(kFrames));
   for (int i = 0; i < kFrames; ++i) EXPECT_EQ(sink.frames[i], recorded.frames[i].frame);
   EXPECT_EQ(sink.with_image, run.composited);
+  EXPECT_EQ(stage.skips, run.composites_skipped) << "the stage is told of every frame it did not make";
 }
 
 TEST(PipelineRecordingTest, OptionsAreCheckedBeforeAnyWork) {

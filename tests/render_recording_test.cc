@@ -114,5 +114,34 @@ TEST(RenderRecordingTest, CourtyardBCompositesMatchThePathTracedFramesWithObject
   ExpectIssue18Bars(volume);
 }
 
+// A frame whose composite the pipeline leaves out (a live camera's while it is behind) still has
+// its light published with the irradiance volume (--serve): FollowLight leaves the volume as a
+// composite of that frame would, at the last composite's sun, without GL work.
+TEST(RenderRecordingTest, AFrameWithoutACompositeLeavesTheVolumeAsItsCompositeWould) {
+  std::string why;
+  const auto gl = HeadlessGlContext::Create(&why);
+  ASSERT_NE(gl, nullptr) << why;
+  const testing::BundledCourtyard& c = testing::Courtyard();
+  const scene::RayCaster caster(c.scene.model);
+  // Two frames of the first burst (clear) and one of the overcast burst: other lights.
+  const std::vector<pipeline::FrameFit> fits = pipeline::FitRecordingFrames(c.scene, c.bake, caster, {0, 60, 330});
+  ASSERT_EQ(fits.size(), 3u);
+  const glm::vec3 sun = fits[0].sun_dir;
+  FrameRenderer composited(c.scene, c.bake, caster), followed(c.scene, c.bake, caster);
+  std::vector<float> out;
+  followed.FollowLight(fits[0].fit.light, fits[0].fit.overcast_share);  // before any composite: nothing to follow
+  followed.Render(fits[0].frame, fits[0].fit.light, fits[0].fit.overcast_share, sun, &out);
+  for (size_t i = 1; i < fits.size(); ++i) {
+    composited.Render(fits[i].frame, fits[i].fit.light, fits[i].fit.overcast_share, sun, &out);
+    followed.FollowLight(fits[i].fit.light, fits[i].fit.overcast_share);
+    ASSERT_NE(composited.volume(), nullptr);
+    sh::Sh9Snapshot a, b;
+    composited.volume()->Snapshot(&a);
+    followed.volume()->Snapshot(&b);
+    ASSERT_EQ(a.coefficients.size(), b.coefficients.size());
+    EXPECT_EQ(a.coefficients, b.coefficients) << "frame position " << i;
+  }
+}
+
 }  // namespace
 }  // namespace daylit::render
