@@ -77,10 +77,13 @@ async function measure(browser, frames, name) {
       const pairs = [['sun_r', message.primaryLightIntensity.x], ['sun_g', message.primaryLightIntensity.y],
                      ['sun_b', message.primaryLightIntensity.z], ['sky_r', message.skyIrradiance.x],
                      ['sky_g', message.skyIrradiance.y], ['sky_b', message.skyIrradiance.z],
-                     ['sun_elevation_deg', message.sunElevationDeg], ['confidence', message.confidence]];
-      // estimates.csv keeps 6 significant digits (the confidence 4 decimals).
+                     ['sun_elevation_deg', message.sunElevationDeg]];
+      // estimates.csv keeps 6 significant digits (a relative rounding of at most 5e-6) and the
+      // confidence 4 decimals (an absolute one of 5e-5: relative, it grows as the confidence falls).
       const worst = Math.max(...pairs.map(([k, v]) => Math.abs(v - Number(row[k])) / Math.max(Math.abs(Number(row[k])), 1e-3)));
-      check(worst < 1e-4, `${name}: /lighting matches estimates.csv's row (worst relative difference ${worst.toExponential(2)})`);
+      const confidence = Math.abs(message.confidence - Number(row.confidence));
+      check(worst < 1e-5 && confidence <= 5.1e-5, `${name}: /lighting matches estimates.csv's row (worst relative difference ` +
+            `${worst.toExponential(2)}, the confidence ${confidence.toExponential(2)} off)`);
     }
 
     const page = await browser.newPage({ viewport: { width: scene.camera.width, height: scene.camera.height + 40 } });
