@@ -25,9 +25,14 @@ void RequireRegularFile(const std::filesystem::path& path) {
 }
 
 std::filesystem::path ResolvedPath(const std::filesystem::path& path) {
+  // An empty path is the current folder here (the folder of a bare file name), as the system's
+  // calls take it; std::filesystem::absolute("") throws.
+  const std::filesystem::path given = path.empty() ? std::filesystem::path(".") : path;
   std::error_code ec;
-  const std::filesystem::path p = std::filesystem::weakly_canonical(std::filesystem::absolute(path), ec);
-  return ec ? std::filesystem::absolute(path).lexically_normal() : p;
+  const std::filesystem::path absolute = std::filesystem::absolute(given, ec);
+  if (ec) return given.lexically_normal();
+  const std::filesystem::path p = std::filesystem::weakly_canonical(absolute, ec);
+  return ec ? absolute.lexically_normal() : p;
 }
 
 bool IsWithin(const std::filesystem::path& path, const std::filesystem::path& folder) {

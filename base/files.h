@@ -15,6 +15,7 @@ std::string WhyNotAFile(const std::filesystem::path& path);
 void RequireRegularFile(const std::filesystem::path& path);
 
 // `path` absolute, through every symbolic link that exists (the final name included), normalised.
+// An empty path is the working folder (the folder of a bare file name).
 std::filesystem::path ResolvedPath(const std::filesystem::path& path);
 // Whether `path` is `folder` or lies inside it, both resolved (ResolvedPath).
 bool IsWithin(const std::filesystem::path& path, const std::filesystem::path& folder);

@@ -540,6 +540,7 @@ Scene LoadScene(const fs::path& path) {
   scene.file = fs::is_directory(status) ? path / "scene.json" : path;
   RequireRegularFile(scene.file);
   scene.folder = scene.file.parent_path();
+  if (scene.folder.empty()) scene.folder = ".";  // `scene.json` named from its own folder
   const nlohmann::json json = ReadJsonFile(scene.file);
   const JsonField root(json, scene.file.string(), "");
   if (!json.is_object()) root.Fail("expected a JSON object");

@@ -1059,6 +1059,35 @@ TEST(CliTest, BadInputExitsWithCode2AndOneLine) {
 // An output never lands on what the run reads (issue 43): `--out` naming the recording's video,
 // env map, model, frames.csv, ground truth or scene files, one of a command's input images, or a
 // symlink to any of them, is refused with exit 2 before any work, and every input keeps its bytes.
+// Paths as a user types them, relative to the folder they are in: a scene named by its bare file
+// name from its own folder (its folder the working one: it was "a path: Invalid argument", exit
+// 2), an --out without a folder; the refusal to replace a recording's file holds there too.
+TEST(CliTest, PathsRelativeToTheWorkingFolderWork) {
+  const fs::path dir = fs::temp_directory_path() / ("daylit_cli_relative_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const fs::path rec = dir / "rec";
+  fs::create_directories(rec);
+  for (const char* f : {"scene.json", "model.obj", "frames.csv", "video.mp4", "envmap.exr", "groundtruth.csv"}) {
+    fs::copy_file(fs::path(kRecording) / f, rec / f);
+  }
+  fs::create_symlink(fs::path(kRecording) / "groundtruth", rec / "groundtruth");
+  const std::string cache = std::string(DAYLIT_BINARY_DIR) + "/test-cache/courtyard-a";
+  const std::string in_recording = "cd " + rec.string() + " && ", in_dir = "cd " + dir.string() + " && ";
+  const auto from_its_folder = Daylit("estimate scene.json --cache " + cache + " --frames 3 --out " + (dir / "a.csv").string(),
+                                      in_recording);
+  EXPECT_EQ(from_its_folder.exit_code, 0) << from_its_folder.err;
+  EXPECT_EQ(ReadCsvFile(dir / "a.csv").rows.size(), 3u);
+  const auto bare_out = Daylit("estimate rec --cache " + cache + " --frames 3 --out b.csv", in_dir);
+  EXPECT_EQ(bare_out.exit_code, 0) << bare_out.err;
+  EXPECT_EQ(ReadCsvFile(dir / "b.csv").rows.size(), 3u);
+  const std::string frames = ReadTextFile(rec / "frames.csv");
+  const auto replacing = Daylit("estimate scene.json --cache " + cache + " --frames 3 --out frames.csv", in_recording);
+  EXPECT_EQ(replacing.exit_code, 2) << replacing.err;
+  EXPECT_NE(replacing.err.find("frames.csv"), std::string::npos) << replacing.err;
+  EXPECT_EQ(ReadTextFile(rec / "frames.csv"), frames);
+  fs::remove_all(dir);
+}
+
 TEST(CliTest, AnOutputThatNamesAnInputIsRefusedAndTheInputIsUntouched) {
   const fs::path dir = fs::temp_directory_path() / ("daylit_cli_inputs_" + std::to_string(::getpid()));
   fs::remove_all(dir);
