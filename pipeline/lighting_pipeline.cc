@@ -22,6 +22,13 @@ using Clock = std::chrono::steady_clock;
 
 double MillisecondsSince(Clock::time_point t0) { return 1e3 * std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+// The wall clock (a camera's frames carry its time), seconds since the Unix epoch.
+double UnixSecondsNow() {
+  timespec now{};
+  ::clock_gettime(CLOCK_REALTIME, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
+
 }  // namespace
 
 std::string LightingPipelineOptions::Check() const {
@@ -51,13 +58,7 @@ PipelineRun LightingPipeline::Run(std::unique_ptr<capture::FrameSource> source) 
   scene::SunTracker sun_tracker(scene_, options_.sun);
   estimation::FrameEstimator estimator(scene_, bake_, caster_, options_.estimator);
   const bool live = source->live();
-  if (live) {
-    timespec now{};
-    ::clock_gettime(CLOCK_REALTIME, &now);
-    const scene::TrackedSun& sun =
-        sun_tracker.Update(UtcFromUnixSeconds(static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec)));
-    if (stage_ != nullptr) stage_->Prepare(sun);
-  }
+  if (live && stage_ != nullptr) stage_->Prepare(sun_tracker.Update(UtcFromUnixSeconds(UnixSecondsNow())));
   // A camera's read-ahead never keeps it waiting (the driver would drop frames); its queue holds
   // what arrives during a slow frame (a sun move: a few hundred ms) so that every frame is still
   // estimated: up to kLiveQueueBytes of frames, the most lag.
@@ -88,12 +89,7 @@ PipelineRun LightingPipeline::Run(std::unique_ptr<capture::FrameSource> source) 
     const Clock::time_point began = Clock::now();
     const estimation::FrameLight light = readable ? estimator.Estimate(frame, sun) : estimator.Hold(frame, sun);
     if (readable) (light.sun_moved ? run.sun_moves_ms : estimate_ms).push_back(MillisecondsSince(began));
-    if (readable && live) {
-      timespec now{};
-      ::clock_gettime(CLOCK_REALTIME, &now);
-      const double now_s = static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
-      run.latency_ms.push_back(1e3 * (now_s - UnixSeconds(frame.utc)));
-    }
+    if (readable && live) run.latency_ms.push_back(1e3 * (UnixSecondsNow() - UnixSeconds(frame.utc)));
     if (!readable) {
       ++run.undecodable;
       frame.rgb.release();
@@ -132,13 +128,16 @@ double LightingPipeline::Deliver(const capture::Frame& frame, const estimation::
   const bool readable = !frame.rgb.empty();
   double ms = -1.0;
   PipelineFrame out{frame, light, sun};
-  if (stage_ != nullptr && readable && !image) stage_->Skip(light);
-  if (stage_ != nullptr && readable && image) {
-    if (video_ != nullptr) image_ = video_->TakeBuffer();
-    const Clock::time_point t0 = Clock::now();
-    out.image_light = stage_->Process(frame, light, sun, &image_);
-    ms = MillisecondsSince(t0);
-    out.image = &image_;
+  if (stage_ != nullptr && readable) {
+    if (image) {
+      if (video_ != nullptr) image_ = video_->TakeBuffer();
+      const Clock::time_point t0 = Clock::now();
+      out.image_light = stage_->Process(frame, light, sun, &image_);
+      ms = MillisecondsSince(t0);
+      out.image = &image_;
+    } else {
+      stage_->Skip(light);
+    }
   }
   for (FrameSink* sink : sinks_) sink->Consume(out);
   if (video_ != nullptr) {

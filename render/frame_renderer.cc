@@ -99,7 +99,7 @@ void FrameRenderer::RenderLinear(const estimation::SunSky& light, double overcas
     input.lights = &env_lights_->Update(e);
     input.lights_generation = env_lights_->generation();
   } else if (volume_) {
-    volume_->SetCombination({&volume_parts_[0], &volume_parts_[1], &volume_parts_[2]}, {e.sun, e.clear, e.overcast});
+    FollowLight(light, overcast_share);
     input.volume = volume_.get();
   }
   shadows_.SetSun(sun_dir);
