@@ -20,7 +20,7 @@ packages=(
   libglm-dev libglfw3-dev libegl-dev libgl-dev libgles-dev libepoxy-dev libegl-mesa0
   libgl1-mesa-dri libgbm-dev libopenexr-dev libimath-dev libembree-dev libtbb-dev
   nlohmann-json3-dev libcli11-dev
-  libcpp-httplib-dev libspdlog-dev libfmt-dev libtinyobjloader-dev libtinygltf-dev libstb-dev liberfa-dev
+  libevent-dev libcpp-httplib-dev libspdlog-dev libfmt-dev libtinyobjloader-dev libtinygltf-dev libstb-dev liberfa-dev
 )
 # The tests, benchmarks, sanitizer and fuzz builds, the window tests' X server, the viewer's
 # browser test, the live tests' faked clock, the loaded run's CPU hog, the batch workflow's engine

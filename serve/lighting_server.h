@@ -10,29 +10,19 @@
 //   GET /video.mjpg           the camera frames as MJPEG (multipart/x-mixed-replace), one per frame
 //   GET /                     the browser viewer (web/viewer: three.js, served from this server,
 //                             nothing fetched from elsewhere)
-// The pipeline only hands messages over (a copy under a lock); the network is the server's
-// threads'. A client that falls behind loses its oldest messages (counted, and said in the
-// stream as an `event: dropped`); one that takes nothing for a while, or cannot be written to
-// for two seconds, is closed. Many clients at once, each on its own thread.
+// The pipeline only hands messages over (a copy under a lock); the network is the server's own
+// thread's: one event loop (libevent) for every connection, so a client that sends its request a
+// byte a second, or reads nothing, holds a socket and no worker, and /lighting answers beside a
+// hundred of them. A client that falls behind loses its oldest messages (counted, and said in
+// the stream as an `event: dropped`); one that takes nothing for a while, or cannot be written to
+// for two seconds, is closed.
 #pragma once
 
-#include <chrono>
-#include <condition_variable>
 #include <cstdint>
-#include <deque>
-#include <list>
 #include <memory>
-#include <mutex>
-#include <optional>
 #include <string>
-#include <thread>
 
 #include "serve/lighting_message.h"
-
-namespace httplib {
-class Server;
-struct Response;
-}
 
 namespace daylit::serve {
 
@@ -41,10 +31,14 @@ struct ServerOptions {
   int port = 0;                   // 0: any free port (tests)
   size_t queued_per_client = 64;  // messages a stream client may fall behind before losing them
   int idle_close_s = 10;          // a stream client whose queue stayed full this long is closed
-  int max_clients = 32;           // stream and video clients at once; more are answered 503
+  int max_clients = 128;          // stream and video clients at once; more are answered 503
+  int max_connections = 512;      // connections at once; the next is answered 503 and closed
+  int read_stall_ms = 1000;       // a client silent this long while it owes a request is closed
+  int request_ms = 2000;          // a request's line and headers must all arrive within this
+  int write_stall_ms = 2000;      // a client that cannot be written to this long is closed
   int jpeg_quality = 90;
-  // A request with more header fields, or more bytes of them, is answered 431 (cpp-httplib limits
-  // each line to 8 KiB, not their number): a browser sends about 20, 2 KiB.
+  // A request with more header fields, or more bytes of them, is answered 431; a request line
+  // over 8 KiB 414, a header line over 8 KiB 400. A browser sends about 20 fields, 2 KiB.
   size_t max_header_fields = 100;
   size_t max_header_bytes = 32 * 1024;
   // The viewer's files: viewer/ (index.html, viewer.js) and node_modules/three (scripts/setup.sh
@@ -61,6 +55,8 @@ struct ServerStats {
   uint64_t clients_seen = 0;   // stream clients that connected
   uint64_t clients_closed = 0; // closed by the server (behind, or not writable)
   uint64_t jpegs = 0;          // frames encoded as JPEG (once per frame, however many viewers)
+  uint64_t refused = 0;        // connections answered 503 at the cap
+  uint64_t timed_out = 0;      // connections closed for a request too slow or a stall
 };
 
 class LightingServer {
@@ -78,35 +74,9 @@ class LightingServer {
   ServerStats stats() const;
 
  private:
-  struct Client {
-    std::deque<std::shared_ptr<const std::string>> queue;
-    uint64_t dropped_unsaid = 0;  // lost since the last `event: dropped`
-    std::optional<std::chrono::steady_clock::time_point> full_since;  // behind since, until it takes
-    bool closed = false;
-  };
-  void Stop();
-  // `lighting`'s frame as a JPEG, encoded once and shared; null without an image.
-  std::shared_ptr<const std::string> Jpeg(const std::shared_ptr<const FrameLighting>& lighting);
-  bool AdmitClient(httplib::Response* res);  // under mutex_: false (503 said) when full
-
-  ServerOptions options_;
-  std::string scene_json_;
-  std::unique_ptr<httplib::Server> server_;
-  std::thread listener_;
+  class Loop;  // the event loop and its connections (lighting_server.cc)
+  std::unique_ptr<Loop> loop_;
   int port_ = 0;
-
-  mutable std::mutex mutex_;
-  std::condition_variable changed_;
-  std::shared_ptr<const FrameLighting> latest_;
-  std::shared_ptr<const std::string> latest_json_;
-  std::list<std::shared_ptr<Client>> clients_;
-  int video_clients_ = 0;
-  bool viewer_ = false;  // the viewer's files were found
-  std::mutex jpeg_mutex_;  // taken before mutex_ when both are held
-  std::shared_ptr<const FrameLighting> jpeg_of_;
-  std::shared_ptr<const std::string> jpeg_;
-  ServerStats stats_;
-  bool stopping_ = false;
 };
 
 }  // namespace daylit::serve
