@@ -85,8 +85,11 @@ VideoDecoder::VideoDecoder(const std::filesystem::path& path) : state_(std::make
   s.codec->thread_count = 1;  // the pipeline runs frames on its own threads
   if (avcodec_open2(s.codec, decoder, nullptr) < 0) ThrowInputError("{}: cannot open the decoder", path.string());
   if (s.codec->pix_fmt != AV_PIX_FMT_YUV420P && s.codec->pix_fmt != AV_PIX_FMT_YUVJ420P) {
+    // An undetermined format (AV_PIX_FMT_NONE) has no name: a null that fmt refuses with an
+    // exception of its own (exit 3; found by fuzz_video).
+    const char* name = av_get_pix_fmt_name(s.codec->pix_fmt);
     ThrowInputError("{}: pixel format {} is not supported (expected yuv420p)", path.string(),
-                    av_get_pix_fmt_name(s.codec->pix_fmt));
+                    name != nullptr ? name : "unknown");
   }
   s.packet = av_packet_alloc();
   s.frame = av_frame_alloc();

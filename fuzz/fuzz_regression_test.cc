@@ -43,7 +43,7 @@ TEST_P(FuzzRegressionTest, EveryKeptInputEndsWithAResultOrAnInputError) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Targets, FuzzRegressionTest,
-                         ::testing::Values("scene_json", "obj", "csv", "exr", "hdr", "gltf", "bake_cache"),
+                         ::testing::Values("scene_json", "obj", "csv", "exr", "hdr", "gltf", "bake_cache", "video", "http_request"),
                          [](const ::testing::TestParamInfo<std::string>& param) { return param.param; });
 
 }  // namespace

@@ -20,11 +20,14 @@
 #include "base/log.h"
 #include "capture/frame_times.h"
 #include "capture/response.h"
+#include "capture/video_decoder.h"
+#include "capture/video_encoder.h"
 #include "scene/envmap_probe.h"
 #include "scene/hdr_image.h"
 #include "scene/model.h"
 #include "scene/object_mesh.h"
 #include "scene/scene.h"
+#include "serve/http_request.h"
 #include "sunmodel/sunpos_batch.h"
 
 namespace daylit::fuzz {
@@ -304,6 +307,77 @@ void SeedsBakeCache(const fs::path& dir) {
   }
 }
 
+// A recording's video, decoded as every command reads it: opened, up to 8 frames read, a seek
+// back to the first and one more read. A stream that cannot be read is an InputError; one that
+// decodes in part goes on (errors counted).
+void RunVideo(const uint8_t* data, size_t size) {
+  const fs::path path = Scratch() / "video.mp4";
+  WriteBytes(path, data, size);
+  ExpectOnlyInputErrors("video", [&] {
+    capture::VideoDecoder decoder(path);
+    cv::Mat rgb;
+    for (int i = 0; i < 8 && decoder.Next(&rgb); ++i) {
+    }
+    decoder.Seek(0);
+    decoder.Next(&rgb);
+  });
+}
+
+// Small videos as the recordings' (H.264 in MP4 and in Matroska, a few frames of a gradient).
+void SeedsVideo(const fs::path& dir) {
+  for (const char* name : {"tiny.mp4", "tiny.mkv"}) {
+    capture::VideoEncoderOptions options;
+    options.fps = 10.0;
+    capture::VideoEncoder encoder(dir / name, 32, 16, options);
+    for (int f = 0; f < 4; ++f) {
+      cv::Mat rgb(16, 32, CV_32FC3);
+      for (int y = 0; y < rgb.rows; ++y) {
+        for (int x = 0; x < rgb.cols; ++x) rgb.at<cv::Vec3f>(y, x) = cv::Vec3f(static_cast<float>(x) / 32.0f, static_cast<float>(y) / 16.0f, static_cast<float>(f) / 4.0f);
+      }
+      encoder.Write(rgb);
+    }
+    encoder.Finish();
+  }
+}
+
+// The bytes a client sends the lighting server, read as request heads one after another as a
+// kept-alive connection would. The reader throws nothing; what it says must hold for the bytes.
+void RunHttpRequest(const uint8_t* data, size_t size) {
+  serve::RequestLimits limits;
+  limits.max_line = 256, limits.max_fields = 8, limits.max_field_bytes = 1024;  // reachable by short inputs
+  serve::RequestReader reader(limits);
+  std::string input(reinterpret_cast<const char*>(data), size);
+  const auto fail = [](const char* what) {
+    std::fprintf(stderr, "fuzz target http_request: %s\n", what);
+    std::abort();
+  };
+  for (;;) {
+    const size_t before = input.size();
+    const serve::RequestReader::State state = reader.Read(&input);
+    if (input.size() > before) fail("the input grew");
+    if (state == serve::RequestReader::State::kReading) {
+      if (input.find('\n') != std::string::npos || input.size() > limits.max_line) fail("waits with a line to read");
+      return;
+    }
+    if (state == serve::RequestReader::State::kRefused) {
+      const int s = reader.status();
+      if ((s != 400 && s != 414 && s != 431) || reader.reason().empty()) fail("a refusal without its status");
+      return;
+    }
+    if (reader.method().empty() || reader.target().empty() || reader.method().find(' ') != std::string::npos) {
+      fail("a request without a method or target");
+    }
+    if (input.size() == before) fail("complete without reading");
+    reader.Reset();
+  }
+}
+
+void SeedsHttpRequest(const fs::path& dir) {
+  WriteText(dir / "get.seed", "GET /lighting?at=1,2,3 HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n");
+  WriteText(dir / "pipelined.seed", "GET /scene HTTP/1.1\r\n\r\nGET /stream HTTP/1.0\r\nConnection: keep-alive\r\n\r\n");
+  WriteText(dir / "body.seed", "POST / HTTP/1.1\nContent-Length: 3\n\nabc");
+}
+
 }  // namespace
 
 void ExpectOnlyInputErrors(std::string_view target, const std::function<void()>& body) {
@@ -326,6 +400,8 @@ const std::vector<Target>& Targets() {
       {"hdr", QuietLogs, RunHdr, SeedsHdr},
       {"gltf", QuietLogs, RunGltf, SeedsGltf},
       {"bake_cache", [] { QuietLogs(), Cache(); }, RunBakeCache, SeedsBakeCache},
+      {"video", [] { QuietLogs(), capture::RouteLibavLogging(); }, RunVideo, SeedsVideo},
+      {"http_request", QuietLogs, RunHttpRequest, SeedsHttpRequest},
   };
   return targets;
 }

@@ -24,7 +24,8 @@ struct Target {
   std::function<void(const std::filesystem::path& dir)> write_seeds;
 };
 
-// Every target, by name: scene_json, obj, csv, exr, hdr, gltf, bake_cache.
+// Every target, by name: scene_json, obj, csv, exr, hdr, gltf, bake_cache, video (a recording's
+// H.264 through capture::VideoDecoder), http_request (the lighting server's request heads).
 const std::vector<Target>& Targets();
 const Target& FindTarget(std::string_view name);
 

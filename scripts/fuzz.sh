@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/targets.h: scene.json, OBJ, CSV, OpenEXR, Radiance HDR,
-# glTF, the bake cache) with clang, -fsanitize=fuzzer,address,undefined, in build-fuzz/, and
+# glTF, the bake cache, a recording's video, the lighting server's request heads) with clang,
+# -fsanitize=fuzzer,address,undefined, in build-fuzz/, and
 # runs each for SECONDS (default 60; libFuzzer's -max_total_time), as many at once as there are
 # cores. Seeds: each target's own small files plus the bundled recordings' scene.json, model.obj
 # and CSV files; the corpus each run grows is kept in build-fuzz/corpus/ for the next run.
@@ -13,7 +14,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 targets=("$@")
-if [ ${#targets[@]} -eq 0 ]; then targets=(scene_json obj csv exr hdr gltf bake_cache); fi
+if [ ${#targets[@]} -eq 0 ]; then targets=(scene_json obj csv exr hdr gltf bake_cache video http_request); fi
 
 bash scripts/setup.sh
 build=build-fuzz

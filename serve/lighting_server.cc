@@ -38,6 +38,7 @@
 #include "base/error.h"
 #include "base/files.h"
 #include "base/log.h"
+#include "serve/http_request.h"
 
 namespace daylit::serve {
 namespace {
@@ -88,17 +89,6 @@ std::string MimeType(const std::filesystem::path& file) {
   return "application/octet-stream";
 }
 
-bool EqualsNoCase(std::string_view a, std::string_view b) {
-  return a.size() == b.size() &&
-         std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) { return std::tolower(x) == std::tolower(y); });
-}
-
-std::string_view Trimmed(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-  return s;
-}
-
 }  // namespace
 
 ServerOptions ParseHostPort(const std::string& text, const char* where) {
@@ -124,8 +114,8 @@ ServerOptions ParseHostPort(const std::string& text, const char* where) {
   return o;
 }
 
-// One thread runs a libevent loop over every connection. HTTP/1.1 GET requests are read line by
-// line from each connection's buffer (the server answers nothing else), so that the limits on a
+// One thread runs a libevent loop over every connection. HTTP/1.1 GET requests are read from each
+// connection's input by a RequestReader (the server answers nothing else), so that the limits on a
 // request's time, lines and fields, and the cap on connections with its 503, are the server's own:
 // libevent 2.1's evhttp has no connection cap and times a request only by its silences.
 class LightingServer::Loop {
@@ -150,15 +140,14 @@ class LightingServer::Loop {
     std::optional<std::chrono::steady_clock::time_point> full_since;  // behind since, until it takes
     bool closed = false;  // behind for too long: the loop closes it
   };
-  enum class State { kRequestLine, kHeaders, kStream, kVideo, kClosing };
+  enum class State { kRequest, kStream, kVideo, kClosing };
   struct Connection {
     Loop* loop = nullptr;
     bufferevent* bev = nullptr;
     event* deadline = nullptr;  // the request's whole time
-    State state = State::kRequestLine;
-    std::string method, target;
-    bool http10 = false, close_asked = false, keep_alive_asked = false, has_body = false;
-    size_t fields = 0, header_bytes = 0;
+    State state = State::kRequest;
+    RequestReader reader;
+    std::string input;  // received, not yet read as a request
     std::shared_ptr<Client> client;                         // a /stream
     std::shared_ptr<const FrameLighting> video_sent;        // a /video.mjpg: the frame last sent
     std::chrono::steady_clock::time_point last_sent;
@@ -330,10 +319,8 @@ void LightingServer::Loop::Accept(evutil_socket_t fd) {
 }
 
 void LightingServer::Loop::AwaitRequest(Connection* c) {
-  c->state = State::kRequestLine;
-  c->method.clear(), c->target.clear();
-  c->http10 = c->close_asked = c->keep_alive_asked = c->has_body = false;
-  c->fields = c->header_bytes = 0;
+  c->state = State::kRequest;
+  c->reader = RequestReader(RequestLimits{kMaxLine, options_.max_header_fields, options_.max_header_bytes});
   const timeval whole{options_.request_ms / 1000, (options_.request_ms % 1000) * 1000};
   evtimer_add(c->deadline, &whole);
 }
@@ -365,7 +352,7 @@ void LightingServer::Loop::Event(Connection* c, short what) {
       const std::lock_guard<std::mutex> lock(mutex_);
       ++stats_.clients_closed;
     }
-    if (writing || c->state == State::kRequestLine || c->state == State::kHeaders) return TimedOut(c);
+    if (writing || c->state == State::kRequest) return TimedOut(c);
     // A stream or video client that sends nothing is what it should be: read on.
     bufferevent_enable(c->bev, EV_READ);
     return;
@@ -384,65 +371,32 @@ void LightingServer::Loop::Written(Connection* c) {
 
 void LightingServer::Loop::Read(Connection* c) {
   evbuffer* in = bufferevent_get_input(c->bev);
-  while (c->state == State::kRequestLine || c->state == State::kHeaders) {
-    size_t n = 0;
-    char* raw = evbuffer_readln(in, &n, EVBUFFER_EOL_CRLF);
-    if (raw == nullptr) {
-      if (evbuffer_get_length(in) <= kMaxLine) return;  // the rest of the line is still to come
-      if (c->state == State::kRequestLine) return AnswerJsonError(c, 414, "a request line over 8 KiB", true);
-      return AnswerJsonError(c, 400, "a header line over 8 KiB", true);
-    }
-    const std::string line(raw, n);
-    free(raw);
-    if (n > kMaxLine) {
-      return c->state == State::kRequestLine ? AnswerJsonError(c, 414, "a request line over 8 KiB", true)
-                                             : AnswerJsonError(c, 400, "a header line over 8 KiB", true);
-    }
-    if (c->state == State::kRequestLine) {
-      if (line.empty()) continue;  // a blank line before a request may be ignored (RFC 9112 2.2)
-      const size_t a = line.find(' '), b = line.rfind(' ');
-      const std::string version = b == std::string::npos ? "" : line.substr(b + 1);
-      if (a == std::string::npos || a == b || (version != "HTTP/1.1" && version != "HTTP/1.0")) {
-        return AnswerJsonError(c, 400, "not an HTTP/1.x request line", true);
-      }
-      c->method = line.substr(0, a);
-      c->target = line.substr(a + 1, b - a - 1);
-      c->http10 = version == "HTTP/1.0";
-      c->state = State::kHeaders;
-      continue;
-    }
-    if (line.empty()) {
-      evtimer_del(c->deadline);
-      Dispatch(c);
-      continue;  // a kept-alive connection reads its next request, if it came along
-    }
-    ++c->fields;
-    c->header_bytes += n + 2;
-    if (c->fields > options_.max_header_fields || c->header_bytes > options_.max_header_bytes) {
-      return AnswerJsonError(c, 431,
-                             fmt::format("more than {} header fields or {} bytes of them: at most {} and {}",
-                                         options_.max_header_fields, options_.max_header_bytes,
-                                         options_.max_header_fields, options_.max_header_bytes),
-                             true);
-    }
-    const size_t colon = line.find(':');
-    if (colon == std::string::npos) return AnswerJsonError(c, 400, "a header line without ':'", true);
-    const std::string_view name = Trimmed(std::string_view(line).substr(0, colon));
-    const std::string_view value = Trimmed(std::string_view(line).substr(colon + 1));
-    if (EqualsNoCase(name, "connection")) {
-      if (value.find("close") != std::string_view::npos) c->close_asked = true;
-      if (EqualsNoCase(value, "keep-alive")) c->keep_alive_asked = true;
-    } else if (EqualsNoCase(name, "transfer-encoding") || (EqualsNoCase(name, "content-length") && value != "0")) {
-      c->has_body = true;  // not read: the answer closes the connection
+  const size_t received = evbuffer_get_length(in);
+  if (c->state != State::kRequest) {
+    evbuffer_drain(in, received);  // a stream or video client's further bytes mean nothing
+    return;
+  }
+  const size_t had = c->input.size();
+  c->input.resize(had + received);
+  evbuffer_remove(in, c->input.data() + had, received);
+  while (c->state == State::kRequest) {
+    switch (c->reader.Read(&c->input)) {
+      case RequestReader::State::kReading:
+        return;
+      case RequestReader::State::kRefused:
+        return AnswerJsonError(c, c->reader.status(), c->reader.reason(), true);
+      case RequestReader::State::kComplete:
+        evtimer_del(c->deadline);
+        Dispatch(c);  // a kept-alive connection then reads its next request, if it came along
+        break;
     }
   }
-  // A stream or video client's further bytes mean nothing.
-  if (c->state == State::kStream || c->state == State::kVideo) evbuffer_drain(in, evbuffer_get_length(in));
+  c->input.clear();
 }
 
 void LightingServer::Loop::Answer(Connection* c, int status, std::string_view type, const std::string& body,
                                   const Headers& extra, bool close) {
-  const bool keep_alive = !close && !c->close_asked && !c->has_body && (!c->http10 || c->keep_alive_asked);
+  const bool keep_alive = !close && c->reader.keep_alive();
   const std::string head = ResponseHead(status, type, body.size(), extra, keep_alive);
   bufferevent_write(c->bev, head.data(), head.size());
   bufferevent_write(c->bev, body.data(), body.size());
@@ -456,10 +410,11 @@ void LightingServer::Loop::Answer(Connection* c, int status, std::string_view ty
 }
 
 void LightingServer::Loop::Dispatch(Connection* c) {
-  if (c->method != "GET") return Answer(c, 405, "application/json", JsonError("only GET"), {{"Allow", "GET"}});
-  const size_t q = c->target.find('?');
-  const std::string path = c->target.substr(0, q);
-  const std::string query = q == std::string::npos ? "" : c->target.substr(q + 1);
+  if (c->reader.method() != "GET") return Answer(c, 405, "application/json", JsonError("only GET"), {{"Allow", "GET"}});
+  const std::string target = c->reader.target();
+  const size_t q = target.find('?');
+  const std::string path = target.substr(0, q);
+  const std::string query = q == std::string::npos ? "" : target.substr(q + 1);
   if (path == "/lighting") return Lighting(c, query);
   if (path == "/scene") return Answer(c, 200, "application/json", scene_json_);
   if (path == "/stream") return Stream(c);
@@ -528,11 +483,11 @@ void LightingServer::Loop::StaticFile(Connection* c, const std::filesystem::path
   // Only a file under the folder, where its links lead too: no '..', no way out.
   if (name.empty() || name.find('\0') != std::string::npos || !IsWithin(ResolvedPath(file), ResolvedPath(root)) ||
       !std::filesystem::is_regular_file(file)) {
-    return AnswerJsonError(c, 404, fmt::format("no {} here", c->target));
+    return AnswerJsonError(c, 404, fmt::format("no {} here", c->reader.target()));
   }
   std::ifstream in(file, std::ios::binary);
   std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in && !in.eof()) return AnswerJsonError(c, 500, fmt::format("{} cannot be read", c->target));
+  if (!in && !in.eof()) return AnswerJsonError(c, 500, fmt::format("{} cannot be read", c->reader.target()));
   Answer(c, 200, MimeType(file), body);
 }
 
