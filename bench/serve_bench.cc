@@ -4,7 +4,10 @@
 //    clients connected: a copy of courtyard-a's irradiance volume (10 × 8 × 4 probes), the frame
 //    shared, the message made (SH at the volume's centre) and handed to every client;
 //  - BM_ServeLatency/4: frames published every 10 ms; how long after its Publish each client
-//    has a frame's message (median and worst over every frame and client).
+//    has a frame's message (median and worst over every frame and client);
+//  - BM_LightingUnderLoad: issue 52's bar: 100 slow-loris clients (a byte every 0.4 s, replaced
+//    when closed) and 50 stream clients while frames come at 30 fps; how long a GET /lighting on
+//    a new connection takes (median, 99th percentile and worst of 150).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -22,6 +25,7 @@
 #include "base/log.h"
 #include "base/statistics.h"
 #include "serve/lighting_server.h"
+#include "serve/load_clients.h"
 
 namespace daylit::serve {
 namespace {
@@ -150,6 +154,45 @@ void BM_ServeLatency(benchmark::State& state) {
   state.counters["latency_worst_ms"] = PercentileInPlace(latency_ms, 1.0, 0.0);
 }
 BENCHMARK(BM_ServeLatency)->Arg(4)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_LightingUnderLoad(benchmark::State& state) {
+  SetLogVerbosity(0);
+  const sh::Sh9Snapshot volume = CourtyardVolume();
+  const cv::Mat image(540, 960, CV_32FC3, cv::Scalar(0.5f, 0.4f, 0.3f));
+  constexpr int kFrames = 300, kStreams = 50;  // 10 s at 30 fps
+  std::vector<double> answer_ms;
+  uint64_t refused = 0, timed_out = 0;
+  for (auto _ : state) {
+    auto server = std::make_unique<LightingServer>(ServerOptions{}, "{}");
+    server->Publish(SinkFrame(0, volume, nullptr, image));
+    {
+      SlowClients slow(server->port(), 100);
+      Readers readers(server->port(), kStreams, kFrames);
+      WaitFor(readers, *server);
+      const Clock::time_point start = Clock::now();
+      for (int f = 1; f < kFrames; ++f) {
+        std::this_thread::sleep_until(start + std::chrono::microseconds(33333 * f));
+        server->Publish(SinkFrame(f, volume, nullptr, image));
+        if (f % 2 != 0) continue;
+        const Clock::time_point asked = Clock::now();
+        httplib::Client client("127.0.0.1", server->port());
+        client.set_read_timeout(5, 0);
+        const httplib::Result res = client.Get("/lighting");
+        answer_ms.push_back(res && res->status == 200 ? std::chrono::duration<double, std::milli>(Clock::now() - asked).count()
+                                                      : 1e9);
+      }
+      refused = server->stats().refused;
+      timed_out = server->stats().timed_out;
+      server.reset();  // ends the readers' streams before they are joined
+    }
+  }
+  state.counters["answer_median_ms"] = PercentileInPlace(answer_ms, 0.5, 0.0);
+  state.counters["answer_p99_ms"] = PercentileInPlace(answer_ms, 0.99, 0.0);
+  state.counters["answer_worst_ms"] = PercentileInPlace(answer_ms, 1.0, 0.0);
+  state.counters["slow_closed"] = static_cast<double>(timed_out);
+  state.counters["refused"] = static_cast<double>(refused);
+}
+BENCHMARK(BM_LightingUnderLoad)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace daylit::serve

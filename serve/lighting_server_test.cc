@@ -29,6 +29,7 @@
 #include "base/csv.h"
 #include "base/error.h"
 #include "scene/hdr_image.h"
+#include "serve/load_clients.h"
 
 namespace daylit::serve {
 namespace {
@@ -188,21 +189,6 @@ TEST(LightingServerTest, ManyStreamClientsEachGetEveryFrameInOrder) {
   EXPECT_EQ(server.stats().dropped, 0u);
 }
 
-// A plain TCP connection to the server on loopback, for clients that misbehave; -1 if it fails.
-int ConnectTo(int port) {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  if (fd < 0) return -1;
-  sockaddr_in addr{};
-  addr.sin_family = AF_INET;
-  addr.sin_port = htons(static_cast<uint16_t>(port));
-  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (connect(fd, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)) != 0) {
-    close(fd);
-    return -1;
-  }
-  return fd;
-}
-
 // A client that connects and never reads: Publish never waits for it, it loses its oldest
 // messages once the socket's buffers are full (counted), and a client reading beside it gets the
 // frames in order, up to the last.
@@ -271,55 +257,6 @@ TEST(LightingServerTest, ARequestWithTooManyHeaderFieldsIsRefused) {
   ASSERT_TRUE(answered);
   EXPECT_EQ(answered->status, 200);
 }
-
-// Clients that send their requests a byte at a time, slower than any request may take: each is
-// closed when its request's time is up (2 s), and reconnects, so that `count` of them are always
-// there, as in a slow-loris attack.
-class SlowClients {
- public:
-  SlowClients(int port, int count) {
-    thread_ = std::thread([this, port, count] {
-      const std::string request = "GET /lighting HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: " + std::string(4000, 'a');
-      std::vector<std::pair<int, size_t>> sockets;  // fd, bytes sent
-      while (!stop_) {
-        while (static_cast<int>(sockets.size()) < count) {
-          const int fd = ConnectTo(port);
-          if (fd < 0) break;
-          sockets.emplace_back(fd, 0);
-          ++connects_;
-        }
-        for (auto& [fd, sent] : sockets) {
-          char byte = request[sent % request.size()];
-          // Closed by the server: a reset, or EOF waiting to be read. Then another in its place.
-          char peek = 0;
-          const ssize_t peeked = recv(fd, &peek, 1, MSG_DONTWAIT | MSG_PEEK);
-          const bool gone = peeked == 0 || (peeked < 0 && errno != EAGAIN && errno != EWOULDBLOCK) ||
-                            send(fd, &byte, 1, MSG_NOSIGNAL | MSG_DONTWAIT) != 1;
-          if (gone) {
-            close(fd);
-            fd = -1;
-          } else {
-            ++sent;
-          }
-        }
-        sockets.erase(std::remove_if(sockets.begin(), sockets.end(), [](const auto& s) { return s.first < 0; }),
-                      sockets.end());
-        std::this_thread::sleep_for(std::chrono::milliseconds(400));
-      }
-      for (const auto& [fd, sent] : sockets) close(fd);
-    });
-  }
-  ~SlowClients() {
-    stop_ = true;
-    thread_.join();
-  }
-  int connects() const { return connects_; }
-
- private:
-  std::atomic<bool> stop_{false};
-  std::atomic<int> connects_{0};
-  std::thread thread_;
-};
 
 // Issue 52's bar: /lighting answers within 50 ms while 100 clients send their requests a byte at a
 // time and 50 stream clients read every frame at 30 fps (it answered 0 of 20 within 5 s when each
