@@ -106,4 +106,50 @@ nlohmann::json LightingJson(const FrameLighting& l, const std::optional<glm::vec
   return j;
 }
 
+std::string SceneJson(const scene::Scene& scene) {
+  const scene::CameraIntrinsics& k = scene.intrinsics;
+  nlohmann::json rotation = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r) {
+    rotation.push_back({scene.cam_from_world.rotation[0][r], scene.cam_from_world.rotation[1][r], scene.cam_from_world.rotation[2][r]});
+  }
+  const glm::dvec3 t = scene.cam_from_world.translation, center = scene.Camera().CenterInWorld();
+  nlohmann::json j = {
+      {"version", kLightingSchema},
+      {"name", scene.name},
+      {"units", "m"},
+      {"up", {0, 0, 1}},
+      {"north_azimuth_deg", scene.north_azimuth_deg},
+      {"camera",
+       {{"convention", "OpenCV: x right, y down, z forward; x_cam = R x_world + t"},
+        {"width", k.width}, {"height", k.height}, {"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy},
+        {"world_to_camera", {{"rotation", rotation}, {"translation", {t.x, t.y, t.z}}}},
+        {"center", {center.x, center.y, center.z}}}},
+  };
+  j["camera"]["response"] = scene.response.Describe();
+  j["camera"]["exposure"] = scene.exposure;
+  nlohmann::json objects = nlohmann::json::array();
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const scene::VirtualObject& o = scene.objects[i];
+    const glm::dvec3 albedo = o.albedo.value_or(glm::dvec3(0.5));
+    nlohmann::json object = {
+        {"position", {o.position.x, o.position.y, o.position.z}},
+        {"rotation_deg", {o.rotation_deg.x, o.rotation_deg.y, o.rotation_deg.z}},
+        {"scale", {o.scale.x, o.scale.y, o.scale.z}},
+        {"albedo", {albedo.x, albedo.y, albedo.z}},
+    };
+    switch (o.kind) {
+      case scene::MeshKind::kSphere: object["mesh"] = "sphere", object["radius"] = o.radius; break;
+      case scene::MeshKind::kBox: object["mesh"] = "box", object["size"] = {o.size.x, o.size.y, o.size.z}; break;
+      case scene::MeshKind::kFile: object["mesh"] = "file", object["file"] = o.file.filename().string(); break;
+    }
+    objects.push_back(std::move(object));
+  }
+  j["objects"] = std::move(objects);
+  if (scene.volume) {
+    j["volume"] = {{"min", {scene.volume->min.x, scene.volume->min.y, scene.volume->min.z}},
+                   {"max", {scene.volume->max.x, scene.volume->max.y, scene.volume->max.z}}};
+  }
+  return j.dump();
+}
+
 }  // namespace daylit::serve

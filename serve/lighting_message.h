@@ -18,6 +18,7 @@
 #include "capture/response.h"
 
 #include "estimation/frame_estimator.h"
+#include "scene/scene.h"
 #include "sh/irradiance_volume.h"
 #include "sh/sh9.h"
 
@@ -67,6 +68,11 @@ struct FrameLighting {
 // The message: sphericalHarmonicsCoefficients at `at` (default the volume box's centre), or null
 // without a volume.
 nlohmann::json LightingJson(const FrameLighting& lighting, const std::optional<glm::vec3>& at = std::nullopt);
+
+// What GET /scene tells a renderer that places its own camera (docs/serve.md): intrinsics,
+// world_to_camera and the camera's centre, response and exposure, up, north, units, the virtual
+// objects and the volume's box.
+std::string SceneJson(const scene::Scene& scene);
 
 // The 27 numbers of sphericalHarmonicsCoefficients from irradiance coefficients (the volume's,
 // E(n) = Σ_c e_c Y_c(n)): radiance coefficients L_lm = e_lm / Â_l, the form three.js's LightProbe

@@ -138,6 +138,32 @@ TEST(LightingServerTest, LightingIs503BeforeTheFirstFrameThenTheLatestWithWebXrN
   EXPECT_EQ(res->body, R"({"units": "m"})");
 }
 
+// GET /scene's text for a bundled recording: the camera as scene.json gives it (rows of
+// world_to_camera, its centre -R^T t), north, and the objects and volume a renderer places.
+TEST(SceneJsonTest, TheCameraObjectsAndVolumeOfTheScene) {
+  const scene::Scene scene = scene::LoadScene(DAYLIT_SOURCE_DIR "/recordings/courtyard-a");
+  const nlohmann::json j = nlohmann::json::parse(SceneJson(scene));
+  EXPECT_EQ(j["version"], kLightingSchema);
+  EXPECT_EQ(j["units"], "m");
+  EXPECT_DOUBLE_EQ(j["camera"]["fx"].get<double>(), scene.intrinsics.fx);
+  EXPECT_EQ(j["camera"]["width"], scene.intrinsics.width);
+  const glm::dmat3& r = scene.cam_from_world.rotation;
+  const glm::dvec3 t = scene.cam_from_world.translation;
+  for (int row = 0; row < 3; ++row) {
+    for (int col = 0; col < 3; ++col) {
+      EXPECT_DOUBLE_EQ(j["camera"]["world_to_camera"]["rotation"][row][col].get<double>(), r[col][row]);
+    }
+  }
+  const glm::dvec3 center = -glm::transpose(r) * t;
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(j["camera"]["center"][i].get<double>(), center[i], 1e-9);
+  EXPECT_DOUBLE_EQ(j["north_azimuth_deg"].get<double>(), scene.north_azimuth_deg);
+  ASSERT_EQ(j["objects"].size(), scene.objects.size());
+  ASSERT_FALSE(scene.objects.empty());
+  EXPECT_DOUBLE_EQ(j["objects"][0]["position"][0].get<double>(), scene.objects[0].position.x);
+  ASSERT_TRUE(scene.volume.has_value());
+  EXPECT_DOUBLE_EQ(j["volume"]["max"][2].get<double>(), scene.volume->max.z);
+}
+
 TEST(LightingServerTest, ShCoefficientsAreTheVolumesRadianceCoefficientsAtThePointAsked) {
   LightingServer server({}, "{}");
   auto l = Frame(3);

@@ -24,6 +24,7 @@
 #include "evaluation/lighting_truth.h"
 #include "evaluation/run_report.h"
 #include "pipeline/lighting_pipeline.h"
+#include "pipeline/serve_sink.h"
 #include "pipeline/stages.h"
 #include "pipeline/video_output.h"
 #include "pipeline/window_sink.h"
@@ -54,90 +55,6 @@ struct ReplayOptions {
   std::string serve;         // [HOST:]PORT of the lighting server; empty: none
   bool pace = false;         // a recording at its own pace (as in a window)
   bool hold = false;         // --serve: keep serving the last frame after the run, until Ctrl-C
-};
-
-// What GET /scene tells a renderer that places its own camera (docs/serve.md).
-std::string SceneJson(const scene::Scene& scene) {
-  const scene::CameraIntrinsics& k = scene.intrinsics;
-  nlohmann::json rotation = nlohmann::json::array();
-  for (int r = 0; r < 3; ++r) {
-    rotation.push_back({scene.cam_from_world.rotation[0][r], scene.cam_from_world.rotation[1][r], scene.cam_from_world.rotation[2][r]});
-  }
-  const glm::dvec3 t = scene.cam_from_world.translation, center = scene.Camera().CenterInWorld();
-  nlohmann::json j = {
-      {"version", serve::kLightingSchema},
-      {"name", scene.name},
-      {"units", "m"},
-      {"up", {0, 0, 1}},
-      {"north_azimuth_deg", scene.north_azimuth_deg},
-      {"camera",
-       {{"convention", "OpenCV: x right, y down, z forward; x_cam = R x_world + t"},
-        {"width", k.width}, {"height", k.height}, {"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy},
-        {"world_to_camera", {{"rotation", rotation}, {"translation", {t.x, t.y, t.z}}}},
-        {"center", {center.x, center.y, center.z}}}},
-  };
-  j["camera"]["response"] = scene.response.Describe();
-  j["camera"]["exposure"] = scene.exposure;
-  nlohmann::json objects = nlohmann::json::array();
-  for (size_t i = 0; i < scene.objects.size(); ++i) {
-    const scene::VirtualObject& o = scene.objects[i];
-    const glm::dvec3 albedo = o.albedo.value_or(glm::dvec3(0.5));
-    nlohmann::json object = {
-        {"position", {o.position.x, o.position.y, o.position.z}},
-        {"rotation_deg", {o.rotation_deg.x, o.rotation_deg.y, o.rotation_deg.z}},
-        {"scale", {o.scale.x, o.scale.y, o.scale.z}},
-        {"albedo", {albedo.x, albedo.y, albedo.z}},
-    };
-    switch (o.kind) {
-      case scene::MeshKind::kSphere: object["mesh"] = "sphere", object["radius"] = o.radius; break;
-      case scene::MeshKind::kBox: object["mesh"] = "box", object["size"] = {o.size.x, o.size.y, o.size.z}; break;
-      case scene::MeshKind::kFile: object["mesh"] = "file", object["file"] = o.file.filename().string(); break;
-    }
-    objects.push_back(std::move(object));
-  }
-  j["objects"] = std::move(objects);
-  if (scene.volume) {
-    j["volume"] = {{"min", {scene.volume->min.x, scene.volume->min.y, scene.volume->min.z}},
-                   {"max", {scene.volume->max.x, scene.volume->max.y, scene.volume->max.z}}};
-  }
-  return j.dump();
-}
-
-// Each frame's lighting to the lighting server: the estimate, the sun in scene and camera
-// coordinates, the irradiance volume as the renderer left it (a copy of its coefficients), the
-// relit map's parts (shrunk once per sun) and the camera frame (shared, not copied).
-class ServeSink : public pipeline::FrameSink {
- public:
-  ServeSink(const scene::Scene& scene, const render::FrameRenderer& renderer, serve::LightingServer* server)
-      : scene_(scene), renderer_(renderer), server_(server),
-        response_(std::make_shared<const capture::CameraResponse>(scene.response)) {}
-  void Consume(const pipeline::PipelineFrame& f) override {
-    auto l = std::make_shared<serve::FrameLighting>();
-    l->row = f.light.row;
-    l->exposure = f.frame.exposure;
-    l->overcast_share = f.light.overcast_share;
-    l->sun_scene = f.sun.dir_in_scene;
-    l->sun_camera = glm::vec3(scene_.cam_from_world.rotation * glm::dvec3(f.sun.dir_in_scene));
-    if (const sh::IrradianceVolume* volume = renderer_.volume()) volume->Snapshot(&l->volume);
-    if (renderer_.env_basis_generation() != envmap_generation_) {
-      const relight::EnvBasis& basis = renderer_.env_basis();
-      const relight::EnvRelighter& map = renderer_.relighter();
-      envmap_ = serve::ShrinkEnvMapParts(map.width(), map.height(), basis.sun, basis.clear, basis.overcast);
-      envmap_generation_ = renderer_.env_basis_generation();
-    }
-    l->envmap = envmap_;
-    l->image = f.frame.rgb;
-    if (f.frame.linear) l->linear_response = response_;
-    server_->Publish(std::move(l));
-  }
-
- private:
-  const scene::Scene& scene_;
-  const render::FrameRenderer& renderer_;
-  serve::LightingServer* server_;
-  std::shared_ptr<const capture::CameraResponse> response_;
-  std::shared_ptr<const serve::EnvMapParts> envmap_;
-  int envmap_generation_ = 0;
 };
 
 // daylit live --calibrate: the camera's frames through the estimator, for at most `seconds`, cut
@@ -279,7 +196,7 @@ void RunReplay(const ReplayOptions& o) {
   if (o.hold && o.serve.empty()) ThrowInputError("--hold: needs --serve");
   // The port is taken before any work, so that a port in use fails at once.
   std::optional<serve::LightingServer> server;
-  if (!o.serve.empty()) server.emplace(serve::ParseHostPort(o.serve, "--serve"), SceneJson(scene));
+  if (!o.serve.empty()) server.emplace(serve::ParseHostPort(o.serve, "--serve"), serve::SceneJson(scene));
   render::FrameRendererOptions render_options;
   render_options.lights = render::ParseLighting(o.lighting, "--lighting");
   RequireValid("render options", render_options.Check());
@@ -322,7 +239,7 @@ void RunReplay(const ReplayOptions& o) {
   pipeline::LightingPipeline lighting(scene, baked, caster, options);
   lighting.SetStage(&composite);
   lighting.AddSink(&fidelity);
-  std::optional<ServeSink> serving;
+  std::optional<pipeline::ServeSink> serving;
   if (server) lighting.AddSink(&serving.emplace(scene, renderer, &*server));
   if (window) lighting.AddSink(&shown.emplace(scene, window.get(), &slider));
   if (video) lighting.SetVideo(&video->writer());
