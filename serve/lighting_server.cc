@@ -140,6 +140,9 @@ class LightingServer::Loop {
     std::optional<std::chrono::steady_clock::time_point> full_since;  // behind since, until it takes
     bool closed = false;  // behind for too long: the loop closes it
   };
+  // kClosing: its last answer is being written; then its sending side is shut and what it still
+  // sends is read and dropped until it closes or a second passes (a close with unread input would
+  // reset the connection, and the client could lose the answer: an error's above all).
   enum class State { kRequest, kStream, kVideo, kClosing };
   struct Connection {
     Loop* loop = nullptr;
@@ -161,6 +164,7 @@ class LightingServer::Loop {
   }
   static void OnDeadline(evutil_socket_t, short, void* c) {
     auto* conn = static_cast<Connection*>(c);
+    if (conn->state == State::kClosing) return conn->loop->Close(conn);  // its linger is over
     conn->loop->TimedOut(conn);
   }
   static void OnNotify(evutil_socket_t, short, void* self) { static_cast<Loop*>(self)->Deliver(false); }
@@ -346,7 +350,7 @@ void LightingServer::Loop::TimedOut(Connection* c) {
 }
 
 void LightingServer::Loop::Event(Connection* c, short what) {
-  if ((what & BEV_EVENT_TIMEOUT) != 0) {
+  if ((what & BEV_EVENT_TIMEOUT) != 0 && c->state != State::kClosing) {
     const bool writing = (what & BEV_EVENT_WRITING) != 0;
     if (writing && (c->state == State::kStream || c->state == State::kVideo)) {
       const std::lock_guard<std::mutex> lock(mutex_);
@@ -362,7 +366,13 @@ void LightingServer::Loop::Event(Connection* c, short what) {
 
 void LightingServer::Loop::Written(Connection* c) {
   switch (c->state) {
-    case State::kClosing: return Close(c);
+    case State::kClosing: {
+      // Written: no more to send; read what comes until the client closes, a second at most.
+      shutdown(bufferevent_getfd(c->bev), SHUT_WR);
+      const timeval linger{1, 0};
+      evtimer_add(c->deadline, &linger);
+      return;
+    }
     case State::kStream: return SendStream(c, false);
     case State::kVideo: return SendVideo(c, false);
     default: return;
@@ -373,7 +383,7 @@ void LightingServer::Loop::Read(Connection* c) {
   evbuffer* in = bufferevent_get_input(c->bev);
   const size_t received = evbuffer_get_length(in);
   if (c->state != State::kRequest) {
-    evbuffer_drain(in, received);  // a stream or video client's further bytes mean nothing
+    evbuffer_drain(in, received);  // a stream, video or closing client's further bytes mean nothing
     return;
   }
   const size_t had = c->input.size();
@@ -403,9 +413,8 @@ void LightingServer::Loop::Answer(Connection* c, int status, std::string_view ty
   if (keep_alive) {
     AwaitRequest(c);
   } else {
-    c->state = State::kClosing;  // closed once written (Written)
+    c->state = State::kClosing;  // shut once written (Written), closed at the client's EOF
     evtimer_del(c->deadline);
-    bufferevent_disable(c->bev, EV_READ);
   }
 }
 

@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -356,6 +357,32 @@ TEST(LightingServerTest, BeyondTheCapOnConnectionsA503AtOnce) {
     return res && res->status == 200;
   }));
   for (const int fd : idle) close(fd);
+}
+
+// A request line of 100 KB is answered 414 as soon as it passes 8 KiB; the rest it sends is read
+// and dropped, so the client reads the whole answer and then the server's close, not a reset
+// that could lose the answer.
+TEST(LightingServerTest, AnOverlongRequestLineGets414AndAnOrderlyClose) {
+  LightingServer server({}, "{}");
+  const int fd = ConnectTo(server.port());
+  ASSERT_GE(fd, 0);
+  const std::string request = "GET /" + std::string(100000, 'a') + " HTTP/1.1\r\n\r\n";
+  size_t sent = 0;
+  while (sent < request.size()) {
+    const ssize_t n = send(fd, request.data() + sent, request.size() - sent, MSG_NOSIGNAL);
+    ASSERT_GT(n, 0) << "the server stopped reading after " << sent << " bytes: " << std::strerror(errno);
+    sent += static_cast<size_t>(n);
+  }
+  timeval limit{3, 0};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &limit, sizeof(limit));
+  std::string answer;
+  char buffer[4096];
+  ssize_t got = 0;
+  while ((got = read(fd, buffer, sizeof(buffer))) > 0) answer.append(buffer, static_cast<size_t>(got));
+  EXPECT_EQ(got, 0) << "not an orderly close: " << std::strerror(errno);
+  EXPECT_EQ(answer.rfind("HTTP/1.1 414", 0), 0u) << answer;
+  EXPECT_NE(answer.find("Access-Control-Allow-Origin: *"), std::string::npos) << answer;
+  close(fd);
 }
 
 TEST(LightingServerTest, APortTakenIsAnInputErrorNamingItAndWhy) {
