@@ -1,5 +1,7 @@
 #include "capture/video_decoder.h"
 
+#include <cstring>
+
 extern "C" {
 #include <libavcodec/avcodec.h>
 #include <libavformat/avformat.h>
@@ -60,6 +62,17 @@ void LogLibav(void* context, int level, const char* format, va_list args) {
   std::string text(line);
   while (!text.empty() && text.back() == '\n') text.pop_back();
   Log().debug("libav: {}", text);
+}
+
+// libav keeps a stream's colour fields as they are coded (H.264's VUI allows any byte), which may
+// be no value of their enum at all (134 as an AVColorSpace: undefined behaviour to load, found by
+// fuzz_video under UBSan): read as the integer they are stored as.
+template <typename Enum>
+int RawValue(const Enum& field) {
+  static_assert(sizeof(Enum) == sizeof(int));
+  int value = 0;
+  std::memcpy(&value, &field, sizeof(value));
+  return value;
 }
 
 }  // namespace
@@ -123,7 +136,9 @@ int VideoDecoder::width() const { return state_->codec->width; }
 int VideoDecoder::height() const { return state_->codec->height; }
 int VideoDecoder::frames_read() const { return state_->frames; }
 int VideoDecoder::errors() const { return state_->errors; }
-const char* VideoDecoder::matrix() const { return state_->codec->colorspace == AVCOL_SPC_BT709 ? "BT.709" : "BT.601"; }
+const char* VideoDecoder::matrix() const {
+  return RawValue(state_->codec->colorspace) == AVCOL_SPC_BT709 ? "BT.709" : "BT.601";
+}
 
 bool VideoDecoder::Next(cv::Mat* rgb) {
   State& s = *state_;
@@ -132,11 +147,11 @@ bool VideoDecoder::Next(cv::Mat* rgb) {
     if (received == 0 && s.IndexOf(s.frame->best_effort_timestamp) < s.skip_until) continue;  // before a Seek's target
     if (received == 0) {
       s.last_index = s.IndexOf(s.frame->best_effort_timestamp);
-      if (s.frame->color_range == AVCOL_RANGE_JPEG || s.codec->pix_fmt == AV_PIX_FMT_YUVJ420P) {
+      if (RawValue(s.frame->color_range) == AVCOL_RANGE_JPEG || s.codec->pix_fmt == AV_PIX_FMT_YUVJ420P) {
         ThrowInputError("{}: full-range YUV is not supported (expected limited range)", s.path.string());
       }
       Yuv420ToRgb(s.frame->data[0], s.frame->linesize[0], s.frame->data[1], s.frame->linesize[1], s.frame->data[2],
-                  s.frame->linesize[2], s.frame->width, s.frame->height, s.frame->colorspace == AVCOL_SPC_BT709, rgb);
+                  s.frame->linesize[2], s.frame->width, s.frame->height, RawValue(s.frame->colorspace) == AVCOL_SPC_BT709, rgb);
       ++s.frames;
       return true;
     }
