@@ -76,6 +76,8 @@ std::string ResponseHead(int status, std::string_view type, std::optional<size_t
   return head;
 }
 
+timeval Millis(int ms) { return timeval{ms / 1000, (ms % 1000) * 1000}; }
+
 std::string JsonError(const std::string& message) { return nlohmann::json{{"error", message}}.dump(); }
 
 std::string MimeType(const std::filesystem::path& file) {
@@ -187,6 +189,8 @@ class LightingServer::Loop {
   }
   void Lighting(Connection* c, const std::string& query);
   void Stream(Connection* c);
+  // A stream or video answer: its head, no length (it ends with the connection), no read timeout.
+  void StartPushing(Connection* c, State state, const std::string& type);
   void Video(Connection* c);
   void StaticFile(Connection* c, const std::filesystem::path& root, std::string_view rest);
   // New messages and frames to every stream and video client whose socket has taken the last;
@@ -315,8 +319,7 @@ void LightingServer::Loop::Accept(evutil_socket_t fd) {
   }
   connections_.insert(c);
   bufferevent_setcb(c->bev, &Loop::OnRead, &Loop::OnWritten, &Loop::OnEvent, c);
-  const timeval read_stall{options_.read_stall_ms / 1000, (options_.read_stall_ms % 1000) * 1000};
-  const timeval write_stall{options_.write_stall_ms / 1000, (options_.write_stall_ms % 1000) * 1000};
+  const timeval read_stall = Millis(options_.read_stall_ms), write_stall = Millis(options_.write_stall_ms);
   bufferevent_set_timeouts(c->bev, &read_stall, &write_stall);
   bufferevent_enable(c->bev, EV_READ | EV_WRITE);
   AwaitRequest(c);
@@ -325,7 +328,7 @@ void LightingServer::Loop::Accept(evutil_socket_t fd) {
 void LightingServer::Loop::AwaitRequest(Connection* c) {
   c->state = State::kRequest;
   c->reader = RequestReader(RequestLimits{kMaxLine, options_.max_header_fields, options_.max_header_bytes});
-  const timeval whole{options_.request_ms / 1000, (options_.request_ms % 1000) * 1000};
+  const timeval whole = Millis(options_.request_ms);
   evtimer_add(c->deadline, &whole);
 }
 
@@ -511,6 +514,14 @@ bool LightingServer::Loop::Admit(Connection* c) {
   return false;
 }
 
+void LightingServer::Loop::StartPushing(Connection* c, State state, const std::string& type) {
+  c->state = state;
+  const timeval write_stall = Millis(options_.write_stall_ms);
+  bufferevent_set_timeouts(c->bev, nullptr, &write_stall);  // it owes no request: only writes are timed
+  const std::string head = ResponseHead(200, type, std::nullopt, {{"Cache-Control", "no-cache"}}, false);
+  bufferevent_write(c->bev, head.data(), head.size());
+}
+
 void LightingServer::Loop::Stream(Connection* c) {
   if (!Admit(c)) return;
   c->client = std::make_shared<Client>();
@@ -520,11 +531,7 @@ void LightingServer::Loop::Stream(Connection* c) {
     clients_.push_back(c->client);
     ++stats_.clients_seen;
   }
-  c->state = State::kStream;
-  const timeval write_stall{options_.write_stall_ms / 1000, (options_.write_stall_ms % 1000) * 1000};
-  bufferevent_set_timeouts(c->bev, nullptr, &write_stall);
-  const std::string head = ResponseHead(200, "text/event-stream", std::nullopt, {{"Cache-Control", "no-cache"}}, false);
-  bufferevent_write(c->bev, head.data(), head.size());
+  StartPushing(c, State::kStream, "text/event-stream");
   SendStream(c, false);
 }
 
@@ -535,12 +542,7 @@ void LightingServer::Loop::Video(Connection* c) {
     ++video_clients_;
     ++stats_.clients_seen;
   }
-  c->state = State::kVideo;
-  const timeval write_stall{options_.write_stall_ms / 1000, (options_.write_stall_ms % 1000) * 1000};
-  bufferevent_set_timeouts(c->bev, nullptr, &write_stall);
-  const std::string head = ResponseHead(200, std::string("multipart/x-mixed-replace; boundary=") + kVideoBoundary,
-                                        std::nullopt, {{"Cache-Control", "no-cache"}}, false);
-  bufferevent_write(c->bev, head.data(), head.size());
+  StartPushing(c, State::kVideo, std::string("multipart/x-mixed-replace; boundary=") + kVideoBoundary);
   SendVideo(c, false);
 }
 
